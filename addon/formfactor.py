@@ -1,0 +1,101 @@
+"""Analytic form factors from a differential receiver area to a triangular sender.
+
+Lambert's contour formula, F = 1/(2 pi) sum_edges angle_k * (n . unit(r_k x r_k+1)), is exact
+for a polygon entirely above the receiver's tangent plane. The sender is first clipped to that
+half-space ("horizon clipping"), so the result stays exact and finite even when sender and
+receiver touch (a box standing on the floor), where the point-to-point kernel
+cos*cos*A/(pi d^2) diverges.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+# Pairs evaluated per chunk: bounds the (pairs, 6, 3) float64 temporaries to ~50 MB.
+_CHUNK = 250_000
+
+
+def _forward_fill(valid: np.ndarray) -> np.ndarray:
+    """Index of the nearest valid slot at or before each slot, cyclically (valid: (..., K))."""
+    k = valid.shape[-1]
+    idx = np.where(valid, np.arange(k), -1)
+    idx = np.maximum.accumulate(idx, axis=-1)
+    last = np.where(valid, np.arange(k), -1).max(axis=-1, keepdims=True)
+    return np.where(idx < 0, last, idx)
+
+
+def _clip_and_integrate(rel: np.ndarray, n: np.ndarray, eps: float) -> np.ndarray:
+    """Form factors for triangles `rel` (P, 3, 3), vertices relative to the receiver, normal n (P, 3)."""
+    h = np.einsum("pkc,pc->pk", rel, n)  # height of each vertex above the tangent plane
+    inside = h > eps
+    nxt = np.roll(np.arange(3), -1)
+    h1 = h[:, nxt]
+    crossing = inside != inside[:, nxt]
+    denom = np.where(crossing, h - h1, 1.0)
+    s = np.where(crossing, (h - eps) / denom, 0.0)
+    cut = rel + s[..., None] * (rel[:, nxt] - rel)
+    # Sutherland-Hodgman on one plane, as 6 fixed slots (vertex k if inside, then the cut on
+    # edge k if the edge crosses); empty slots repeat a valid neighbour so they add nothing.
+    slots = np.stack([rel, cut], axis=2).reshape(len(rel), 6, 3)
+    valid = np.stack([inside, crossing], axis=2).reshape(len(rel), 6)
+    any_valid = valid.any(axis=1)
+    fill = _forward_fill(valid)
+    slots = np.take_along_axis(slots, fill[..., None], axis=1)
+    a = slots
+    b = np.roll(slots, -1, axis=1)
+    cr = np.cross(a, b)
+    crn = np.linalg.norm(cr, axis=-1)
+    dot = np.einsum("pkc,pkc->pk", a, b)
+    angle = np.arctan2(crn, dot)
+    proj = np.einsum("pkc,pc->pk", cr, n)
+    contrib = np.where(crn > 1e-300, angle * proj / np.where(crn > 1e-300, crn, 1.0), 0.0)
+    f = np.abs(contrib.sum(axis=1)) / (2.0 * np.pi)
+    return np.where(any_valid, f, 0.0)
+
+
+def point_to_triangle(
+    points: np.ndarray,
+    normals: np.ndarray,
+    triangles: np.ndarray,
+    sender_normals: np.ndarray | None = None,
+    eps: float = 1e-9,
+) -> np.ndarray:
+    """(R, S) form factors from receiver points (R, 3) with unit normals (R, 3) to triangles (S, 3, 3).
+
+    With `sender_normals` (S, 3) the senders are one-sided: a receiver behind a sender's plane
+    gets 0. Receivers in the sender's plane get 0 (they see it edge-on).
+    """
+    points = np.asarray(points, dtype=np.float64)
+    normals = np.asarray(normals, dtype=np.float64)
+    triangles = np.asarray(triangles, dtype=np.float64)
+    r, s = len(points), len(triangles)
+    out = np.zeros((r, s))
+    if r == 0 or s == 0:
+        return out
+    rows_per_chunk = max(1, _CHUNK // s)
+    for r0 in range(0, r, rows_per_chunk):
+        x = points[r0 : r0 + rows_per_chunk]
+        nx = normals[r0 : r0 + rows_per_chunk]
+        rel = triangles[None, :, :, :] - x[:, None, None, :]
+        nn = np.broadcast_to(nx[:, None, :], (len(x), s, 3))
+        f = _clip_and_integrate(rel.reshape(-1, 3, 3), nn.reshape(-1, 3), eps).reshape(len(x), s)
+        if sender_normals is not None:
+            facing = np.einsum("rsc,sc->rs", -rel[:, :, 0, :], sender_normals) > 0.0
+            f = np.where(facing, f, 0.0)
+        out[r0 : r0 + len(x)] = f
+    return out
+
+
+def paired_point_to_triangle(
+    points: np.ndarray, normals: np.ndarray, triangles: np.ndarray, sender_normals: np.ndarray | None = None
+) -> np.ndarray:
+    """Form factors for matching rows: point i with normal i to triangle i (all (N, ...))."""
+    points = np.asarray(points, dtype=np.float64)
+    out = np.zeros(len(points))
+    for i0 in range(0, len(points), _CHUNK):
+        sl = slice(i0, i0 + _CHUNK)
+        rel = np.asarray(triangles[sl], dtype=np.float64) - points[sl, None, :]
+        f = _clip_and_integrate(rel, np.asarray(normals[sl], dtype=np.float64), 1e-9)
+        if sender_normals is not None:
+            f = np.where(np.einsum("pc,pc->p", -rel[:, 0, :], sender_normals[sl]) > 0.0, f, 0.0)
+        out[sl] = f
+    return out

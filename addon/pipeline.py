@@ -1,0 +1,49 @@
+"""The engine's front door: validate a SceneData, pick the preset, run the removal.
+
+The command line, the Blender operators and the tests all call `remove_object`.
+"""
+from __future__ import annotations
+
+from typing import Callable, Sequence
+
+import numpy as np
+
+from .errors import DimredError
+from .quality import params_for
+from .removal import RemovalResult, remove
+from .scene import SceneData
+
+
+def validate(scene: SceneData) -> None:
+    """DimredError for input the engine cannot work with (one line saying what)."""
+    hdri = scene.hdri
+    if hdri.ndim != 3 or hdri.shape[2] != 3 or hdri.shape[0] < 2 or hdri.shape[1] < 4:
+        raise DimredError(f"the world image must be an RGB panorama, got an array of shape {hdri.shape}")
+    if hdri.shape[1] != 2 * hdri.shape[0]:
+        raise DimredError(f"the world image is {hdri.shape[1]}x{hdri.shape[0]}: a lat-long panorama is twice as wide as high")
+    bad = ~np.isfinite(hdri)
+    if bad.any():
+        name = scene.hdri_path or "the world image"
+        raise DimredError(f"{name} contains {int(bad.any(axis=2).sum())} pixels with NaN or infinite values")
+    if not np.isfinite(scene.center).all():
+        raise DimredError("the probe centre is not a finite point")
+
+
+def remove_object(
+    scene: SceneData,
+    object_name: str,
+    planes: Sequence[str] = (),
+    quality: str = "balanced",
+    progress: Callable[[str, float], None] | None = None,
+    cancel: Callable[[], bool] | None = None,
+    **overrides,
+) -> RemovalResult:
+    """Remove `object_name` from the scene's panorama; `overrides` change single parameters."""
+    validate(scene)
+    params = params_for(quality, **overrides)
+    result = remove(scene, object_name, list(planes), params, progress, cancel)
+    result.report["quality"] = quality
+    result.report["parameters"] = {k: getattr(params, k) for k in params.__dataclass_fields__}
+    result.report["image_size"] = [int(scene.hdri.shape[1]), int(scene.hdri.shape[0])]
+    result.report.setdefault("notes", []).extend(scene.notes)
+    return result

@@ -1,0 +1,27 @@
+"""Where the removed object can change the light at all, decided before any costly step.
+
+Conservative bounding-sphere tests: a receiver is in the shadow volume of the object from a
+sender when the segment towards the sender's centre passes within (object radius + sender
+radius) of the object's centre; it is in the object's neighbourhood when the object's
+bounding sphere fills more than `reach` of its view (solid-angle fraction (r / d)^2).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+
+def shadow_volume(points: np.ndarray, centres: np.ndarray, radii: np.ndarray, obj_centre: np.ndarray,
+                  obj_radius: float) -> np.ndarray:
+    """(N, S) whether receiver n may be shadowed by the object from sender s."""
+    out = np.zeros((len(points), len(centres)), dtype=bool)
+    for s in range(len(centres)):
+        d = centres[s] - points
+        t = np.clip(np.einsum("ij,ij->i", obj_centre - points, d) / np.maximum(np.einsum("ij,ij->i", d, d), 1e-300), 0, 1)
+        closest = points + t[:, None] * d
+        out[:, s] = np.linalg.norm(closest - obj_centre, axis=1) <= obj_radius + radii[s]
+    return out
+
+
+def neighbourhood(points: np.ndarray, obj_centre: np.ndarray, obj_radius: float, reach: float) -> np.ndarray:
+    """(N,) whether the object's bounding sphere covers more than `reach` of the view."""
+    return np.linalg.norm(points - obj_centre, axis=1) < obj_radius / np.sqrt(reach)

@@ -1,0 +1,245 @@
+"""Vectorised ray casting: what each panorama pixel sees, and which segments are blocked.
+
+`trace_panorama` rasterises every triangle into the lat-long image as seen from the probe
+(the origin of the probe frame) with a depth buffer: a ray from the probe is a pixel, so this
+is exact first-hit ray casting without a loop over pixels. `Occluders` answers "is the segment
+p0 -> p1 blocked?" for many segments at once through a two-level bounding-box hierarchy
+(object, then clusters of 16 triangles), so the cost follows what the segments pass near.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import latlong
+
+_EDGE_SAMPLES = 17
+_BATCH_PIXELS = 1 << 21
+_CLUSTER = 16
+_PAIR_CHUNK = 40_000
+_SEG_CHUNK = 200_000
+
+
+@dataclass
+class PanoramaHits:
+    """First hit of every pixel's ray from the probe; tri = -1 where nothing is hit."""
+
+    tri: np.ndarray  # (H, W) int64
+    distance: np.ndarray  # (H, W) float64, along the unit direction
+    bary: np.ndarray  # (H, W, 2) barycentric weights of vertices 1 and 2
+    directions: np.ndarray  # (H, W, 3) unit directions in the probe frame
+
+    @property
+    def points(self) -> np.ndarray:
+        return self.directions * self.distance[..., None]
+
+
+def _uv_window(tris: np.ndarray, width: int, height: int) -> tuple[np.ndarray, ...]:
+    """Conservative pixel windows (row0, rows, col0, cols) of triangles seen from the origin."""
+    t = np.linspace(0.0, 1.0, _EDGE_SAMPLES)[None, :, None]
+    edges = [tris[:, k, None, :] * (1.0 - t) + tris[:, (k + 1) % 3, None, :] * t for k in range(3)]
+    pts = np.concatenate(edges, axis=1)
+    u, v = latlong.direction_to_uv(pts)
+    rows = (1.0 - v) * height
+    row0 = np.clip(np.floor(rows.min(axis=1)) - 2, 0, height - 1).astype(np.int64)
+    row1 = np.clip(np.ceil(rows.max(axis=1)) + 2, 0, height - 1).astype(np.int64)
+    # The u span is the circle minus its largest gap between samples (handles the seam).
+    us = np.sort(u, axis=1)
+    gaps = np.diff(np.concatenate([us, us[:, :1] + 1.0], axis=1), axis=1)
+    g = gaps.argmax(axis=1)
+    start = us[np.arange(len(us)), (g + 1) % us.shape[1]]
+    span = 1.0 - gaps.max(axis=1)
+    col0 = np.floor(start * width).astype(np.int64) - 2
+    cols = np.ceil(span * width).astype(np.int64) + 5
+    # A triangle around a pole covers every column near that pole.
+    for pole, edge_row in ((np.array([0.0, 0.0, 1.0]), 0), (np.array([0.0, 0.0, -1.0]), height - 1)):
+        inside = _inside(tris, pole[None, :])[:, 0]
+        row0 = np.where(inside & (edge_row == 0), 0, row0)
+        row1 = np.where(inside & (edge_row == height - 1), height - 1, row1)
+        col0 = np.where(inside, 0, col0)
+        cols = np.where(inside, width, cols)
+    cols = np.minimum(cols, width)
+    return row0, row1 - row0 + 1, col0, cols
+
+
+def _edge_normals(tris: np.ndarray) -> np.ndarray:
+    """(T, 3, 3) normals of the planes through the origin and each edge, pointing inward."""
+    a, b, c = tris[:, 0], tris[:, 1], tris[:, 2]
+    en = np.stack([np.cross(b, c), np.cross(c, a), np.cross(a, b)], axis=1)
+    sign = np.sign(np.einsum("ij,ij->i", a, np.cross(b, c)))
+    return en * sign[:, None, None]
+
+
+def _inside(tris: np.ndarray, dirs: np.ndarray) -> np.ndarray:
+    """(T, D) whether directions fall inside each triangle's cone from the origin."""
+    en = _edge_normals(tris)
+    return (np.einsum("tkc,dc->tdk", en, dirs) >= 0.0).all(axis=2)
+
+
+def _rasterise(tris, tri_ids, row0, nrows, col0, ncols, dirs, best, out) -> None:
+    """Depth-test one batch of triangles that share a window shape into the buffers."""
+    h, w = dirs.shape[:2]
+    rr = row0[:, None, None] + np.arange(nrows)[None, :, None]
+    cc = np.mod(col0[:, None, None] + np.arange(ncols)[None, None, :], w)
+    rr = np.broadcast_to(np.minimum(rr, h - 1), (len(tris), nrows, ncols))
+    cc = np.broadcast_to(cc, (len(tris), nrows, ncols))
+    d = dirs[rr, cc]  # (B, nr, nc, 3)
+    en = _edge_normals(tris)
+    lam = np.einsum("bkc,brsc->brsk", en, d)
+    inside = (lam >= -1e-12 * np.abs(lam).max(axis=3, keepdims=True)).all(axis=3)
+    n = np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0])
+    nd = np.einsum("bc,brsc->brs", n, d)
+    na = np.einsum("bc,bc->b", n, tris[:, 0])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        dist = na[:, None, None] / nd
+    ok = inside & (dist > 0.0) & np.isfinite(dist)
+    # Rows past the pole were clamped onto the last row: drop the duplicates.
+    ok &= (row0[:, None, None] + np.arange(nrows)[None, :, None]) < h
+    b, r, s = np.nonzero(ok)
+    if len(b) == 0:
+        return
+    pix = rr[b, r, s] * w + cc[b, r, s]
+    dd = dist[b, r, s]
+    order = np.lexsort((dd, pix))
+    pix, dd, b, r, s = pix[order], dd[order], b[order], r[order], s[order]
+    first = np.ones(len(pix), dtype=bool)
+    first[1:] = pix[1:] != pix[:-1]
+    pix, dd, b, r, s = pix[first], dd[first], b[first], r[first], s[first]
+    closer = dd < best.ravel()[pix]
+    pix, dd, b, r, s = pix[closer], dd[closer], b[closer], r[closer], s[closer]
+    lk = lam[b, r, s]
+    lk = lk / lk.sum(axis=1, keepdims=True)
+    best.ravel()[pix] = dd
+    out["tri"].ravel()[pix] = tri_ids[b]
+    out["bary"].reshape(-1, 2)[pix] = lk[:, 1:]
+
+
+def trace_panorama(triangles: np.ndarray, width: int, height: int) -> PanoramaHits:
+    """First hit of each pixel centre's ray from the origin among `triangles` (T, 3, 3)."""
+    dirs = latlong.pixel_directions(width, height)
+    best = np.full((height, width), np.inf)
+    out = {"tri": np.full((height, width), -1, dtype=np.int64), "bary": np.zeros((height, width, 2))}
+    det = np.einsum("ij,ij->i", triangles[:, 0], np.cross(triangles[:, 1], triangles[:, 2]))
+    scale = np.linalg.norm(triangles, axis=2).max(axis=1) ** 3
+    seen = np.flatnonzero(np.abs(det) > 1e-12 * scale)  # edge-on triangles cover no pixel centre
+    if len(seen):
+        row0, nrows, col0, ncols = _uv_window(triangles[seen], width, height)
+        size = np.maximum(nrows, ncols)
+        bucket = np.maximum(2, np.ceil(np.log2(np.maximum(size, 1)))).astype(int)
+        for k in np.unique(bucket):
+            members = np.flatnonzero(bucket == k)
+            if k <= 6:
+                side = 1 << k
+                per = max(1, _BATCH_PIXELS // (side * side))
+                for i0 in range(0, len(members), per):
+                    m = members[i0 : i0 + per]
+                    _rasterise(triangles[seen[m]], seen[m], row0[m], side, col0[m], side, dirs, best, out)
+            else:
+                for m in members:
+                    sl = slice(m, m + 1)
+                    _rasterise(triangles[seen[sl]], seen[sl], row0[sl], int(nrows[m]), col0[sl], int(ncols[m]), dirs, best, out)
+    distance = np.where(np.isfinite(best), best, 0.0)
+    return PanoramaHits(tri=out["tri"], distance=distance, bary=out["bary"], directions=dirs)
+
+
+def _slab(origin: np.ndarray, inv_dir: np.ndarray, lo: np.ndarray, hi: np.ndarray, tmin, tmax) -> np.ndarray:
+    """Segments o + t d, t in [tmin, tmax], against boxes [lo, hi] (broadcasting)."""
+    with np.errstate(invalid="ignore"):
+        t0 = (lo - origin) * inv_dir
+        t1 = (hi - origin) * inv_dir
+    t0 = np.nan_to_num(t0, nan=-np.inf)
+    t1 = np.nan_to_num(t1, nan=np.inf)
+    near = np.minimum(t0, t1).max(axis=-1)
+    far = np.maximum(t0, t1).min(axis=-1)
+    return (near <= far) & (far >= tmin) & (near <= tmax)
+
+
+class Occluders:
+    """Triangles that can block light, grouped for fast segment queries."""
+
+    def __init__(self, triangles: np.ndarray, tri_object: np.ndarray, eps: float) -> None:
+        self.eps = eps
+        self.objects = []
+        for k in np.unique(tri_object):
+            tris = triangles[tri_object == k]
+            cen = tris.mean(axis=1)
+            lo_o, hi_o = tris.reshape(-1, 3).min(axis=0), tris.reshape(-1, 3).max(axis=0)
+            q = ((cen - lo_o) / np.maximum(hi_o - lo_o, 1e-12) * 1023).astype(np.int64)
+            order = np.argsort(_morton(q))
+            tris = tris[order]
+            n_cl = -(-len(tris) // _CLUSTER)
+            pad = n_cl * _CLUSTER - len(tris)
+            v0 = np.concatenate([tris[:, 0], np.zeros((pad, 3))]).reshape(n_cl, _CLUSTER, 3)
+            e1 = np.concatenate([tris[:, 1] - tris[:, 0], np.zeros((pad, 3))]).reshape(n_cl, _CLUSTER, 3)
+            e2 = np.concatenate([tris[:, 2] - tris[:, 0], np.zeros((pad, 3))]).reshape(n_cl, _CLUSTER, 3)
+            flat = np.concatenate([tris, np.repeat(tris[-1:], pad, axis=0)]).reshape(n_cl, _CLUSTER * 3, 3)
+            margin = eps
+            self.objects.append(
+                dict(
+                    lo=lo_o - margin,
+                    hi=hi_o + margin,
+                    clo=flat.min(axis=1) - margin,
+                    chi=flat.max(axis=1) + margin,
+                    v0=v0,
+                    e1=e1,
+                    e2=e2,
+                )
+            )
+
+    def blocked(self, p0: np.ndarray, p1: np.ndarray) -> np.ndarray:
+        """(N,) whether each open segment p0[i] -> p1[i] hits any triangle."""
+        n = len(p0)
+        out = np.zeros(n, dtype=bool)
+        for i0 in range(0, n, _SEG_CHUNK):
+            sl = slice(i0, i0 + _SEG_CHUNK)
+            out[sl] = self._blocked_chunk(np.asarray(p0[sl], dtype=np.float64), np.asarray(p1[sl], dtype=np.float64))
+        return out
+
+    def _blocked_chunk(self, p0: np.ndarray, p1: np.ndarray) -> np.ndarray:
+        d = p1 - p0
+        length = np.linalg.norm(d, axis=1)
+        tmin = np.minimum(self.eps / np.maximum(length, 1e-300), 0.5)
+        tmax = 1.0 - tmin
+        with np.errstate(divide="ignore"):
+            inv = 1.0 / d
+        out = np.zeros(len(p0), dtype=bool)
+        for ob in self.objects:
+            cand = np.flatnonzero(~out & _slab(p0, inv, ob["lo"], ob["hi"], tmin, tmax))
+            if len(cand) == 0:
+                continue
+            hit_cl = _slab(
+                p0[cand, None, :], inv[cand, None, :], ob["clo"][None], ob["chi"][None], tmin[cand, None], tmax[cand, None]
+            )
+            si, ci = np.nonzero(hit_cl)
+            for j0 in range(0, len(si), _PAIR_CHUNK):
+                s = cand[si[j0 : j0 + _PAIR_CHUNK]]
+                c = ci[j0 : j0 + _PAIR_CHUNK]
+                hit = _moller_trumbore(p0[s], d[s], ob["v0"][c], ob["e1"][c], ob["e2"][c], tmin[s], tmax[s])
+                out[s[hit]] = True
+        return out
+
+
+def _moller_trumbore(o, d, v0, e1, e2, tmin, tmax) -> np.ndarray:
+    """(P,) whether segment p hits any of its cluster's triangles (P, K, 3)."""
+    pvec = np.cross(d[:, None, :], e2)
+    det = np.einsum("pkc,pkc->pk", e1, pvec)
+    ok = np.abs(det) > 1e-20
+    inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
+    tvec = o[:, None, :] - v0
+    u = np.einsum("pkc,pkc->pk", tvec, pvec) * inv
+    qvec = np.cross(tvec, e1)
+    v = np.einsum("pc,pkc->pk", d, qvec) * inv
+    t = np.einsum("pkc,pkc->pk", e2, qvec) * inv
+    hit = ok & (u >= 0.0) & (v >= 0.0) & (u + v <= 1.0) & (t > tmin[:, None]) & (t < tmax[:, None])
+    return hit.any(axis=1)
+
+
+def _morton(q: np.ndarray) -> np.ndarray:
+    """Interleave three 10-bit integers per row into one Morton code (spatial sort key)."""
+    code = np.zeros(len(q), dtype=np.int64)
+    for bit in range(10):
+        for axis in range(3):
+            code |= ((q[:, axis] >> bit) & 1) << (3 * bit + axis)
+    return code
+

@@ -1,0 +1,377 @@
+"""Removing one object's lighting effects from the panorama (DESIGN 3, thesis chapters 3-4).
+
+Three scales work together:
+  * coarse patches over the whole room: radiosity from the panorama, reflectance, estimates
+    for what the probe cannot see, and the propagation of the change for several bounces;
+  * a fine lattice near the object: the light of the many unimportant senders and of the
+    object itself, interpolated to pixels (the thesis's coarse grid of corner samples);
+  * each affected pixel's own 3D point and normal: the important senders (lamps) that the
+    object shadows, with exact form factors and sampled visibility.
+The new radiance is the ratio form L' = L (E + dE) / E (differential rendering), so errors in
+E cancel and texture is kept; only a difference image is returned.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from . import latlong
+from .errors import Cancelled, DimredError
+from .formfactor import paired_point_to_triangle
+from .geometry import Geometry, boundary_objects, build_geometry, plane_of_object, surface_keys
+from .patches import Lattice, build_lattice, levels_for_count, levels_for_size, triangle_samples
+from .planner import neighbourhood, shadow_volume
+from .quality import Params
+from .radiosity import LUMA, RHO_MAX, fill_unseen, patch_radiosity, propagate, recover_reflectance
+from .raycast import Occluders, trace_panorama
+from .report import Report
+from .scene import SceneData
+from .transport import Senders, make_senders, pair_visibility, transport
+
+_MIN_COS = 0.05  # pixels seen more grazing than this count as if at this angle (area weight)
+_VISIBLE = 0.2  # a patch is measured when pixels cover this share of its area
+
+
+@dataclass
+class RemovalResult:
+    difference: np.ndarray  # (H, W, 3) float32, top row first
+    edited: np.ndarray  # (H, W, 3) float32: hdri + difference
+    hidden_mask: np.ndarray  # (H, W) bool: pixels that showed the object
+    report: dict
+
+
+def _cancel_check(cancel: Callable[[], bool] | None) -> Callable[[], None]:
+    def check() -> None:
+        if cancel is not None and cancel():
+            raise Cancelled()
+
+    return check
+
+
+def _interp(values: np.ndarray, corners: np.ndarray, weights: np.ndarray) -> np.ndarray:
+    return np.einsum("nk,nkc->nc", weights, values[corners])
+
+
+@dataclass
+class _Room:
+    """The coarse radiosity solution of the room as photographed."""
+
+    lattice: Lattice
+    senders: Senders
+    important: np.ndarray  # (P,) bool
+    visible: np.ndarray  # (P,) bool
+    emitter: np.ndarray  # (P,) bool
+    rho: np.ndarray  # (P, 3)
+    areas: np.ndarray  # (P,)
+    t_with: np.ndarray  # (V, P) vertex transport with the object
+    t_without: np.ndarray  # (V, P) ... and without it
+
+    def patch_mean(self, vertex_values: np.ndarray) -> np.ndarray:
+        return vertex_values[self.lattice.patch_corners].mean(axis=1)
+
+
+class _Removal:
+    def __init__(self, scene: SceneData, target: int, planes: list[int], params: Params, report: Report, check):
+        self.scene, self.target, self.planes, self.params, self.rep, self.check = scene, target, planes, params, report, check
+        self.hdri = scene.hdri
+        self.height, self.width = scene.hdri.shape[:2]
+
+    # -- stages ---------------------------------------------------------------------------
+    def geometry(self, geo: Geometry) -> None:
+        self.geo = geo
+        self.eps = 1e-6 * geo.scale
+        self.obj_centre, self.obj_radius = geo.bounding_sphere(self.target)
+
+    def trace(self) -> None:
+        hits = trace_panorama(self.geo.triangles, self.width, self.height)
+        self.hits = hits
+        flat_tri = hits.tri.ravel()
+        self.hp = np.flatnonzero(flat_tri >= 0)
+        self.tri_h = flat_tri[self.hp]
+        self.obj_h = self.geo.tri_object[self.tri_h]
+        self.hidden_h = self.obj_h == self.target
+        self.points_h = hits.points.reshape(-1, 3)[self.hp]
+        self.normals_h = self.geo.normals[self.tri_h]
+        missing = len(flat_tri) - len(self.hp)
+        if missing:
+            self.rep.warn(f"{missing} panorama pixels see no proxy geometry (open room?); they are left unchanged")
+        self.rep.info["hidden_pixels"] = int(self.hidden_h.sum())
+
+    def occluders(self) -> None:
+        geo = self.geo
+        seen = np.unique(self.obj_h)
+        witnesses = np.concatenate([geo.triangles[np.isin(geo.tri_object, seen)].reshape(-1, 3), np.zeros((1, 3))])
+        bound = boundary_objects(geo, witnesses)
+        target = geo.tri_object == self.target
+        self.occ_removed = Occluders(geo.triangles[target], geo.tri_object[target], self.eps)
+        other = ~target & ~bound[geo.tri_object]
+        self.occ_others = Occluders(geo.triangles[other], geo.tri_object[other], self.eps) if other.any() else None
+        self.rep.info["occluder_objects"] = [geo.object_names[k] for k in np.unique(geo.tri_object[other])]
+
+    def room(self) -> _Room:
+        geo, prm = self.geo, self.params
+        target_tri = geo.tri_object == self.target
+        levels = np.full(len(geo.triangles), prm.object_level, dtype=np.int64)
+        levels[~target_tri] = levels_for_count(geo.triangles[~target_tri], prm.patches)
+        lat = build_lattice(geo.triangles, levels)
+        ptris = lat.patch_triangles()
+        pnorm = geo.normals[lat.patch_tri]
+        areas = geo.areas[lat.patch_tri] / levels[lat.patch_tri] ** 2
+        on_target = target_tri[lat.patch_tri]
+
+        patch_h, self.corners_h, self.weights_h = lat.locate(self.tri_h, self.hits.bary.reshape(-1, 2)[self.hp])
+        self.patch_h = patch_h
+        cos = np.abs(np.einsum("ij,ij->i", self.hits.directions.reshape(-1, 3)[self.hp], self.normals_h))
+        guarded = int((cos < _MIN_COS).sum())
+        if guarded:
+            self.rep.guard("grazing_pixels_weight_capped", guarded)
+        solid = np.broadcast_to(latlong.pixel_solid_angles(self.width, self.height), (self.height, self.width)).ravel()[self.hp]
+        dist = self.hits.distance.ravel()[self.hp]
+        weight = solid * dist**2 / np.maximum(cos, _MIN_COS)
+        radiance = self.hdri.reshape(-1, 3)[self.hp].astype(np.float64)
+        b, cover = patch_radiosity(radiance, patch_h, weight, areas)
+        visible = cover >= _VISIBLE
+
+        # Important senders are light sources and sunlit spots: much brighter than the typical
+        # surface, ranked by power (thesis 4.3); the rest is gathered on the lattices.
+        power = (b @ LUMA) * areas
+        bright = (b @ LUMA) > prm.bright_factor * np.median((b @ LUMA)[visible & ~on_target])
+        eligible = np.flatnonzero(visible & ~on_target & (power > 0) & bright)
+        important = np.zeros(len(areas), dtype=bool)
+        if len(eligible):
+            order = eligible[np.argsort(-power[eligible])]
+            share = np.cumsum(power[order]) / power[eligible].sum()
+            count = min(int(np.searchsorted(share, prm.sender_fraction) + 1), prm.max_senders, len(order))
+            important[order[:count]] = True
+        imp_idx = np.flatnonzero(important)
+        rest_idx = np.flatnonzero(~important)
+        samples = [
+            (imp_idx, triangle_samples(ptris[imp_idx], prm.sender_samples)),
+            (rest_idx, ptris[rest_idx].mean(axis=1)[:, None, :]),
+        ]
+        senders = make_senders(ptris, pnorm, b, on_target, samples)
+        self.check()
+        vnorm = geo.normals[lat.vertex_tri]
+        t_with, t_without = transport(lat.vertices, vnorm, senders, self.occ_removed, self.occ_others, self.check)
+
+        def mean(v):
+            return v[lat.patch_corners].mean(axis=1)
+
+        e = mean(t_with @ b)
+        e_floor = 1e-9 * max(float((e @ LUMA).max()), 1e-30)
+        keys = surface_keys(geo)[lat.patch_tri]
+        unseen = ~visible
+        for _ in range(3):
+            refl = recover_reflectance(b, e, visible, e_floor)
+            measured = visible & ~refl.emitter & ((e @ LUMA) > e_floor)
+            rho = fill_unseen(refl.rho, measured, [keys, geo.tri_object[lat.patch_tri]], areas)
+            rho[refl.emitter] = 0.0
+            b[unseen] = rho[unseen] * e[unseen]
+            e = mean(t_with @ b)
+        senders.radiosity = b
+        self.rep.guard("reflectance_clamped_patches", refl.clamped)
+        self.rep.guard("irradiance_near_zero_patches", refl.guarded)
+        self.rep.info.update(
+            patches=int(len(areas)),
+            important_senders=int(important.sum()),
+            emitter_patches=int(refl.emitter.sum()),
+            unseen_patches=int(unseen.sum()),
+            coarse_vertices=int(len(lat.vertices)),
+        )
+        self.emitter_h = refl.emitter[patch_h]
+        return _Room(lat, senders, important, visible, refl.emitter, rho, areas, t_with, t_without)
+
+    def first_order_patches(self, room: _Room) -> np.ndarray:
+        """(P, 3) first-order change of irradiance, averaged over each patch."""
+        prm, lat = self.params, room.lattice
+        b = room.senders.radiosity
+        de = room.patch_mean((room.t_without - room.t_with) @ b)
+        ptris = lat.patch_triangles()
+        centre = ptris.mean(axis=1)
+        radius = np.linalg.norm(ptris - centre[:, None, :], axis=2).max(axis=1)
+        imp = np.flatnonzero(room.important)
+        on_target = room.senders.on_removed
+        e = room.patch_mean(room.t_with @ b)
+        near = self._significant(room, imp, centre, e, margin=float(radius.max())).any(axis=1)
+        near |= neighbourhood(centre, self.obj_centre, self.obj_radius + radius, prm.reach)
+        refine = np.flatnonzero(near & ~on_target & ~room.emitter)
+        if len(refine):
+            k = prm.patch_samples
+            pts = triangle_samples(ptris[refine], k).reshape(-1, 3)
+            nrm = np.repeat(room.senders.normals[refine], k * k, axis=0)
+            tw, two = transport(pts, nrm, room.senders, self.occ_removed, self.occ_others, self.check)
+            de[refine] = ((two - tw) @ b).reshape(len(refine), k * k, 3).mean(axis=1)
+        self.rep.info["refined_patches"] = int(len(refine))
+        return de
+
+    def _sender_spheres(self, room: _Room, idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        tris = room.senders.triangles[idx]
+        c = tris.mean(axis=1)
+        return c, np.linalg.norm(tris - c[:, None, :], axis=2).max(axis=1)
+
+    def propagate(self, room: _Room, de1: np.ndarray) -> np.ndarray:
+        """(V, 3) irradiance change at coarse vertices from all patches' radiosity change."""
+        db1 = room.rho * de1
+        db1[room.senders.on_removed | room.emitter] = 0.0
+        total, bounces = propagate(
+            db1, room.rho, room.areas, lambda db: room.patch_mean(room.t_without @ db),
+            self.params.bounce_tolerance, self.params.max_bounces,
+        )
+        self.rep.info["bounces"] = bounces
+        return room.t_without @ total
+
+    def _significant(self, room: _Room, imp: np.ndarray, points: np.ndarray, e_points: np.ndarray,
+                     margin: float = 0.0) -> np.ndarray:
+        """(N, I) receiver-sender pairs where the object may cast a shadow worth computing exactly:
+        inside the shadow volume, and the sender's unblocked light is at least `significance` of E."""
+        imp_c, imp_r = self._sender_spheres(room, imp)
+        sv = shadow_volume(points, imp_c, imp_r + margin, self.obj_centre, self.obj_radius + margin)
+        b_y = room.senders.radiosity[imp] @ LUMA
+        area = np.linalg.norm(np.cross(room.senders.triangles[imp, 1] - room.senders.triangles[imp, 0],
+                                       room.senders.triangles[imp, 2] - room.senders.triangles[imp, 0]), axis=1) / 2
+        d2 = ((points[:, None, :] - imp_c[None]) ** 2).sum(axis=2) + imp_r[None] ** 2
+        bound = b_y[None] * area[None] / (np.pi * d2)
+        return sv & (bound >= self.params.significance * np.maximum(e_points @ LUMA, 1e-30)[:, None])
+
+    def local(self, room: _Room) -> tuple[np.ndarray, np.ndarray]:
+        """Per-pixel E and first-order dE; exact where the object's shadow of a light falls."""
+        prm, geo = self.params, self.geo
+        b = room.senders.radiosity
+        imp = np.flatnonzero(room.important)
+        unimp = ~room.important
+        e_v = room.t_with @ b
+        de_v = (room.t_without - room.t_with)[:, unimp] @ b[unimp]
+        e_pix = _interp(e_v, self.corners_h, self.weights_h)
+        de_pix = _interp(de_v, self.corners_h, self.weights_h)
+
+        cand = ~self.hidden_h & ~self.emitter_h
+        if self.planes:
+            cand &= np.isin(self.obj_h, self.planes)
+        ci = np.flatnonzero(cand)
+        sig = self._significant(room, imp, self.points_h[ci], e_pix[ci])
+        near = neighbourhood(self.points_h[ci], self.obj_centre, self.obj_radius, prm.reach)
+        self.rep.info["affected_pixels"] = int((sig.any(axis=1) | near).sum())
+        if not (sig.any() or near.any()):
+            self.rep.skip("local", "the object neither shadows nor lights any visible surface")
+            return e_pix, de_pix
+
+        # Base for the pixel: the coarse lattice, or near the object a fine one (only the
+        # vertices the pixels use), holding all senders for E and the unimportant ones for dE.
+        pr, ps = np.nonzero(sig)
+        s = imp[ps]
+        pix = ci[pr]
+        lattice_e = (self.weights_h[pix] * room.t_with[self.corners_h[pix], s[:, None]]).sum(axis=1)
+        ni = ci[near]
+        if len(ni):
+            tris_r = np.unique(self.tri_h[ni])
+            levels = np.zeros(len(geo.triangles), dtype=np.int64)
+            levels[tris_r] = levels_for_size(geo.triangles[tris_r], self.obj_radius / prm.fine_cells, max_level=512)
+            fine = build_lattice(geo.triangles, levels)
+            _, corners, weights = fine.locate(self.tri_h[ni], self.hits.bary.reshape(-1, 2)[self.hp[ni]])
+            needed, inverse = np.unique(corners, return_inverse=True)
+            inverse = inverse.reshape(corners.shape)
+            self.check()
+            tf, tf_w = transport(fine.vertices[needed], geo.normals[fine.vertex_tri[needed]], room.senders,
+                                 self.occ_removed, self.occ_others, self.check)
+            self.rep.info["fine_vertices"] = int(len(needed))
+            e_pix[ni] = _interp(tf @ b, inverse, weights)
+            de_pix[ni] = _interp((tf_w - tf)[:, unimp] @ b[unimp], inverse, weights)
+            row = np.full(len(self.hp), -1)
+            row[ni] = np.arange(len(ni))
+            in_fine = row[pix] >= 0
+            k = row[pix[in_fine]]
+            lattice_e[in_fine] = (weights[k] * tf[inverse[k], s[in_fine, None]]).sum(axis=1)
+
+        f = paired_point_to_triangle(self.points_h[pix], self.normals_h[pix], room.senders.triangles[s],
+                                     room.senders.normals[s])
+        vis, vis_w = pair_visibility(self.points_h, room.senders, pix, s, self.occ_removed, self.occ_others, self.check)
+        np.add.at(e_pix, pix, (f * vis - lattice_e)[:, None] * b[s])
+        np.add.at(de_pix, pix, (f * (vis_w - vis))[:, None] * b[s])
+        self.rep.info["exact_pairs"] = int(len(s))
+        return e_pix, de_pix
+
+    def compose(self, e_pix: np.ndarray, de_pix: np.ndarray) -> np.ndarray:
+        """(N, 3) radiance change of the hit pixels from the ratio form, with guards counted."""
+        radiance = self.hdri.reshape(-1, 3)[self.hp].astype(np.float64)
+        apply = ~self.hidden_h & ~self.emitter_h
+        e_ref = float(np.median(e_pix[apply] @ LUMA)) if apply.any() else 0.0
+        dark = (e_pix @ LUMA) <= 1e-6 * max(e_ref, 1e-30)
+        self.rep.guard("irradiance_near_zero_pixels", int((apply & dark & (np.abs(de_pix) @ LUMA > 0)).sum()))
+        apply &= ~dark
+        e = np.maximum(e_pix, 1e-30)
+        implied = np.pi * radiance / e
+        over = implied > RHO_MAX
+        self.rep.guard("reflectance_clamped_pixels", int((apply & over.any(axis=1)).sum()))
+        e_eff = np.where(over, np.pi * radiance / RHO_MAX, e)
+        d = np.where(apply[:, None], radiance * de_pix / np.maximum(e_eff, 1e-30), 0.0)
+        negative = radiance + d < 0.0
+        self.rep.guard("negative_radiance_clamped", int(negative.any(axis=1).sum()))
+        d = np.where(negative, -radiance, d)
+        return d
+
+
+def remove(
+    scene: SceneData,
+    object_name: str,
+    planes: list[str] | tuple[str, ...] = (),
+    params: Params | None = None,
+    progress: Callable[[str, float], None] | None = None,
+    cancel: Callable[[], bool] | None = None,
+) -> RemovalResult:
+    """Remove `object_name`'s shadows and reflected light from the scene's panorama."""
+    params = params or Params()
+    rep = Report(progress, stages=7)
+    check = _cancel_check(cancel)
+    if object_name not in scene.object_names:
+        raise DimredError(f"no mesh object named '{object_name}' among the scene's proxy geometry")
+    target = scene.object_names.index(object_name)
+    with rep.stage("geometry"):
+        geo = build_geometry(scene.triangles, scene.tri_object, scene.object_names, scene.center, scene.rotation)
+        if not (geo.tri_object == target).any():
+            raise DimredError(f"'{object_name}' has no faces to remove")
+        plane_ids = []
+        for name in planes:
+            if name not in geo.object_names:
+                raise DimredError(f"no mesh object named '{name}' for --plane")
+            idx = geo.object_names.index(name)
+            if plane_of_object(geo, idx) is None:
+                raise DimredError(f"'{name}' is not planar: --plane takes flat surfaces only")
+            plane_ids.append(idx)
+        rep.guard("degenerate_triangles_dropped", geo.dropped_degenerate)
+    job = _Removal(scene, target, plane_ids, params, rep, check)
+    job.geometry(geo)
+    with rep.stage("trace"):
+        job.trace()
+    check()
+    with rep.stage("occluders"):
+        job.occluders()
+    with rep.stage("radiosity"):
+        room = job.room()
+    check()
+    with rep.stage("first_order"):
+        de1 = job.first_order_patches(room)
+    with rep.stage("propagation"):
+        de_prop_v = job.propagate(room, de1)
+    check()
+    with rep.stage("local"):
+        e_pix, de_pix = job.local(room)
+    with rep.stage("compose"):
+        de_pix = de_pix + _interp(de_prop_v, job.corners_h, job.weights_h)
+        d = job.compose(e_pix, de_pix)
+        h, w = job.height, job.width
+        difference = np.zeros((h * w, 3), dtype=np.float32)
+        difference[job.hp] = d
+        difference = difference.reshape(h, w, 3)
+        hidden = np.zeros(h * w, dtype=bool)
+        hidden[job.hp[job.hidden_h]] = True
+        hidden = hidden.reshape(h, w)
+        edited = (scene.hdri + difference).astype(np.float32)
+    if not hidden.any():
+        rep.skip("synthesis", "the object is not visible from the probe centre: no hidden region to fill")
+    else:
+        rep.skip("synthesis", "texture synthesis of the hidden region is not available yet")
+        rep.warn(f"the hidden region ({int(hidden.sum())} pixels where the object was seen) was not filled")
+    rep.info["hidden_region_filled"] = False
+    return RemovalResult(difference=difference, edited=edited, hidden_mask=hidden, report=rep.as_dict())

@@ -1,0 +1,96 @@
+"""Light transport from sender patches to receiver points, with and without the removed object.
+
+For receiver x and sender s, T_xs = F_xs * V_xs: the analytic form factor times the fraction of
+the sender's sample points visible from x. The same segments are tested against the removed
+object O and against every other occluder, which gives both operators at once:
+
+    E(x)  = sum_s T_xs B_s            (the scene as photographed)
+    E'(x) = sum_{s not on O} T'_xs B_s  (O gone: its patches send nothing, it blocks nothing)
+
+E' - E is thesis steps 4 and 5 together: light that O blocked comes back, light O reflected
+is taken away.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .formfactor import point_to_triangle
+from .raycast import Occluders
+
+_SEGMENTS_PER_CHUNK = 300_000
+
+
+@dataclass
+class Senders:
+    """Sender patches: triangles, normals, and the visibility sample points of each.
+
+    Senders are sampled at `len(samples[g])` points each, one count per group g, so the
+    important ones can be sampled densely and the rest at their centroid.
+    """
+
+    triangles: np.ndarray  # (S, 3, 3)
+    normals: np.ndarray  # (S, 3)
+    radiosity: np.ndarray  # (S, 3)
+    on_removed: np.ndarray  # (S,) bool: the patch belongs to the removed object
+    group: np.ndarray  # (S,) which sample group
+    slot: np.ndarray  # (S,) row in that group's samples
+    samples: list[np.ndarray]  # per group: (n_g, m_g, 3)
+
+    def __len__(self) -> int:
+        return len(self.triangles)
+
+
+def make_senders(triangles, normals, radiosity, on_removed, sample_sets: list[tuple[np.ndarray, np.ndarray]]) -> Senders:
+    """Senders from (indices, samples) pairs that together cover every sender once."""
+    group = np.zeros(len(triangles), dtype=np.int64)
+    slot = np.zeros(len(triangles), dtype=np.int64)
+    for g, (idx, _) in enumerate(sample_sets):
+        group[idx] = g
+        slot[idx] = np.arange(len(idx))
+    return Senders(triangles, normals, radiosity, on_removed, group, slot, [smp for _, smp in sample_sets])
+
+
+def pair_visibility(
+    points: np.ndarray, senders: Senders, r: np.ndarray, s: np.ndarray, removed: Occluders | None,
+    others: Occluders | None, cancel=None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Visible fractions of sender s[i] from point r[i]: with the removed object, and without it."""
+    vis = np.zeros(len(r))
+    vis_without = np.zeros(len(r))
+    for g, samples in enumerate(senders.samples):
+        sel = np.flatnonzero(senders.group[s] == g)
+        m = samples.shape[1]
+        per = max(1, _SEGMENTS_PER_CHUNK // m)
+        for i0 in range(0, len(sel), per):
+            if cancel is not None:
+                cancel()
+            k = sel[i0 : i0 + per]
+            p0 = np.repeat(points[r[k]], m, axis=0)
+            p1 = samples[senders.slot[s[k]]].reshape(-1, 3)
+            b_o = removed.blocked(p0, p1) if removed is not None else np.zeros(len(p0), dtype=bool)
+            b_x = others.blocked(p0, p1) if others is not None else np.zeros(len(p0), dtype=bool)
+            vis[k] = (~(b_o | b_x)).reshape(-1, m).mean(axis=1)
+            vis_without[k] = (~b_x).reshape(-1, m).mean(axis=1)
+    vis_without = np.where(senders.on_removed[s], 0.0, vis_without)
+    return vis, vis_without
+
+
+def transport(
+    points: np.ndarray,
+    normals: np.ndarray,
+    senders: Senders,
+    removed: Occluders | None,
+    others: Occluders | None,
+    cancel=None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """(T, T') as dense (R, S) float64 matrices for receivers (R, 3) with normals (R, 3)."""
+    f = point_to_triangle(points, normals, senders.triangles, senders.normals)
+    r, s = np.nonzero(f > 0.0)
+    vis, vis_without = pair_visibility(points, senders, r, s, removed, others, cancel)
+    t_with = np.zeros_like(f)
+    t_without = np.zeros_like(f)
+    t_with[r, s] = f[r, s] * vis
+    t_without[r, s] = f[r, s] * vis_without
+    return t_with, t_without
