@@ -11,8 +11,10 @@ import numpy as np
 
 
 def shadow_volume(points: np.ndarray, centres: np.ndarray, radii: np.ndarray, obj_centre: np.ndarray,
-                  obj_radius: float) -> np.ndarray:
-    """(N, S) whether receiver n may be shadowed by the object from sender s."""
+                  obj_radius: float | np.ndarray) -> np.ndarray:
+    """(N, S) whether receiver n may be shadowed by the object from sender s (obj_radius may be
+    per receiver, to widen the test for receivers that stand for an area)."""
+    obj_radius = np.broadcast_to(np.asarray(obj_radius, dtype=np.float64), (len(points),))
     out = np.zeros((len(points), len(centres)), dtype=bool)
     for s in range(len(centres)):
         d = centres[s] - points

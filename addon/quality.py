@@ -15,26 +15,26 @@ class Params:
     """Every user-visible knob of a removal (thesis 4.3-4.5 and DESIGN 3)."""
 
     patches: int = 500  # target number of radiosity patches on the room (coarse solution)
-    object_level: int = 3  # subdivision of each triangle of the removed object
-    sender_fraction: float = 0.8  # important senders hold this share of the total power
+    object_patches: int = 100  # target number of patches on the removed object (at least 1 per triangle)
+    sender_fraction: float = 0.98  # important senders hold this share of the bright patches' power
     max_senders: int = 32  # ... but at most this many (thesis default: 32)
     sender_samples: int = 4  # k: an important sender is sampled at k*k points for visibility
     fine_cells: float = 3.0  # fine grid: cells per object radius, near the object
     reach: float = 0.1  # the object's neighbourhood (fine lattice): where its solid angle exceeds this
     significance: float = 0.01  # shadow of a light computed per pixel where it can change E by this share
     bright_factor: float = 4.0  # important senders are this many times brighter than the median patch
-    patch_samples: int = 3  # k*k points average the first-order change over patches near the object
+    patch_samples: int = 2  # k*k points average the first-order change over patches near the object
     max_bounces: int = 8  # propagation of the change around the room
     bounce_tolerance: float = 2e-3  # stop when a bounce adds less than this share
 
 
 PRESETS = {
-    "draft": Params(patches=200, object_level=2, sender_fraction=0.7, max_senders=12, sender_samples=2,
-                    fine_cells=2.0, reach=0.15, significance=0.03, patch_samples=2, max_bounces=4,
+    "draft": Params(patches=200, object_patches=40, sender_fraction=0.9, max_senders=12, sender_samples=2,
+                    fine_cells=2.0, reach=0.15, significance=0.03, patch_samples=1, max_bounces=4,
                     bounce_tolerance=1e-2),
     "balanced": Params(),
-    "final": Params(patches=1200, object_level=4, sender_fraction=0.9, max_senders=64, sender_samples=6,
-                    fine_cells=5.0, reach=0.05, significance=0.003, patch_samples=4, max_bounces=16,
+    "final": Params(patches=1200, object_patches=300, sender_fraction=0.995, max_senders=64, sender_samples=6,
+                    fine_cells=5.0, reach=0.05, significance=0.003, patch_samples=3, max_bounces=16,
                     bounce_tolerance=5e-4),
 }
 

@@ -65,11 +65,12 @@ class _Room:
     emitter: np.ndarray  # (P,) bool
     rho: np.ndarray  # (P, 3)
     areas: np.ndarray  # (P,)
-    t_with: np.ndarray  # (V, P) vertex transport with the object
-    t_without: np.ndarray  # (V, P) ... and without it
+    t_with: np.ndarray  # (R, P) receiver transport with the object
+    t_without: np.ndarray  # (R, P) ... and without it
+    patch_rows: np.ndarray  # (P, 3) receiver rows averaged for each patch
 
-    def patch_mean(self, vertex_values: np.ndarray) -> np.ndarray:
-        return vertex_values[self.lattice.patch_corners].mean(axis=1)
+    def patch_mean(self, receiver_values: np.ndarray) -> np.ndarray:
+        return receiver_values[self.patch_rows].mean(axis=1)
 
 
 class _Removal:
@@ -113,15 +114,27 @@ class _Removal:
     def room(self) -> _Room:
         geo, prm = self.geo, self.params
         target_tri = geo.tri_object == self.target
-        levels = np.full(len(geo.triangles), prm.object_level, dtype=np.int64)
+        levels = np.ones(len(geo.triangles), dtype=np.int64)
         levels[~target_tri] = levels_for_count(geo.triangles[~target_tri], prm.patches)
+        levels[target_tri] = levels_for_count(geo.triangles[target_tri], prm.object_patches)
         lat = build_lattice(geo.triangles, levels)
         ptris = lat.patch_triangles()
         pnorm = geo.normals[lat.patch_tri]
         areas = geo.areas[lat.patch_tri] / levels[lat.patch_tri] ** 2
         on_target = target_tri[lat.patch_tri]
 
-        patch_h, self.corners_h, self.weights_h = lat.locate(self.tri_h, self.hits.bary.reshape(-1, 2)[self.hp])
+        # Receivers: the lattice vertices of the room, and one centroid per patch of the removed
+        # object (only its patches' means are needed, and it may have many small triangles).
+        room_vertex = ~target_tri[lat.vertex_tri]
+        vertex_row = np.full(len(lat.vertices), 0, dtype=np.int64)
+        vertex_row[room_vertex] = np.arange(room_vertex.sum())
+        target_patches = np.flatnonzero(on_target)
+        patch_rows = vertex_row[lat.patch_corners]
+        patch_rows[target_patches] = (room_vertex.sum() + np.arange(len(target_patches)))[:, None]
+        receivers = np.concatenate([lat.vertices[room_vertex], ptris[target_patches].mean(axis=1)])
+        receiver_normals = np.concatenate([geo.normals[lat.vertex_tri[room_vertex]], pnorm[target_patches]])
+        patch_h, corners_h, self.weights_h = lat.locate(self.tri_h, self.hits.bary.reshape(-1, 2)[self.hp])
+        self.corners_h = vertex_row[corners_h]
         self.patch_h = patch_h
         cos = np.abs(np.einsum("ij,ij->i", self.hits.directions.reshape(-1, 3)[self.hp], self.normals_h))
         guarded = int((cos < _MIN_COS).sum())
@@ -153,11 +166,10 @@ class _Removal:
         ]
         senders = make_senders(ptris, pnorm, b, on_target, samples)
         self.check()
-        vnorm = geo.normals[lat.vertex_tri]
-        t_with, t_without = transport(lat.vertices, vnorm, senders, self.occ_removed, self.occ_others, self.check)
+        t_with, t_without = transport(receivers, receiver_normals, senders, self.occ_removed, self.occ_others, self.check)
 
         def mean(v):
-            return v[lat.patch_corners].mean(axis=1)
+            return v[patch_rows].mean(axis=1)
 
         e = mean(t_with @ b)
         e_floor = 1e-9 * max(float((e @ LUMA).max()), 1e-30)
@@ -178,10 +190,10 @@ class _Removal:
             important_senders=int(important.sum()),
             emitter_patches=int(refl.emitter.sum()),
             unseen_patches=int(unseen.sum()),
-            coarse_vertices=int(len(lat.vertices)),
+            coarse_receivers=int(len(receivers)),
         )
         self.emitter_h = refl.emitter[patch_h]
-        return _Room(lat, senders, important, visible, refl.emitter, rho, areas, t_with, t_without)
+        return _Room(lat, senders, important, visible, refl.emitter, rho, areas, t_with, t_without, patch_rows)
 
     def first_order_patches(self, room: _Room) -> np.ndarray:
         """(P, 3) first-order change of irradiance, averaged over each patch."""
@@ -194,7 +206,7 @@ class _Removal:
         imp = np.flatnonzero(room.important)
         on_target = room.senders.on_removed
         e = room.patch_mean(room.t_with @ b)
-        near = self._significant(room, imp, centre, e, margin=float(radius.max())).any(axis=1)
+        near = self._significant(room, imp, centre, e, margin=radius).any(axis=1)
         near |= neighbourhood(centre, self.obj_centre, self.obj_radius + radius, prm.reach)
         refine = np.flatnonzero(near & ~on_target & ~room.emitter)
         if len(refine):
@@ -223,11 +235,11 @@ class _Removal:
         return room.t_without @ total
 
     def _significant(self, room: _Room, imp: np.ndarray, points: np.ndarray, e_points: np.ndarray,
-                     margin: float = 0.0) -> np.ndarray:
+                     margin: float | np.ndarray = 0.0) -> np.ndarray:
         """(N, I) receiver-sender pairs where the object may cast a shadow worth computing exactly:
         inside the shadow volume, and the sender's unblocked light is at least `significance` of E."""
         imp_c, imp_r = self._sender_spheres(room, imp)
-        sv = shadow_volume(points, imp_c, imp_r + margin, self.obj_centre, self.obj_radius + margin)
+        sv = shadow_volume(points, imp_c, imp_r, self.obj_centre, self.obj_radius + np.asarray(margin))
         b_y = room.senders.radiosity[imp] @ LUMA
         area = np.linalg.norm(np.cross(room.senders.triangles[imp, 1] - room.senders.triangles[imp, 0],
                                        room.senders.triangles[imp, 2] - room.senders.triangles[imp, 0]), axis=1) / 2
