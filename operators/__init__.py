@@ -1,0 +1,17 @@
+"""The `scene.dimred` settings and the `bpy.ops.dimred.*` operators, registered in order."""
+from __future__ import annotations
+
+from . import marking, removal, settings
+
+# Settings first: the operators and the panel read scene.dimred.
+_modules = (settings, marking, removal)
+
+
+def register() -> None:
+    for module in _modules:
+        module.register()
+
+
+def unregister() -> None:
+    for module in reversed(_modules):
+        module.unregister()

@@ -1,0 +1,122 @@
+"""Sidebar panels: the removal set-up and buttons, and a summary of the last run's report."""
+from __future__ import annotations
+
+import json
+
+import bpy
+
+from ..operators import world_layer
+
+CATEGORY = "Diminished Reality"
+
+
+class DIMRED_PT_main(bpy.types.Panel):
+    bl_label = "Diminished Reality"
+    bl_idname = "DIMRED_PT_main"
+    bl_space_type = 'VIEW_3D'
+    bl_region_type = 'UI'
+    bl_category = CATEGORY
+
+    def draw(self, context: bpy.types.Context) -> None:
+        layout = self.layout
+        settings = context.scene.dimred
+
+        box = layout.box()
+        box.label(text="Probe Centre", icon='WORLD')
+        box.prop(settings, "use_probe_center", text="Use This Point")
+        column = box.column(align=True)
+        column.enabled = settings.use_probe_center
+        column.prop(settings, "probe_center", text="")
+        box.operator("dimred.set_probe_center", icon='PIVOT_CURSOR')
+
+        box = layout.box()
+        box.label(text="Object to Remove", icon='OBJECT_DATA')
+        box.prop(settings, "target", text="")
+        box.operator("dimred.mark_remove", icon='RESTRICT_SELECT_OFF')
+
+        box = layout.box()
+        box.label(text="Target Surfaces", icon='MESH_PLANE')
+        names = settings.surface_names()
+        if names:
+            column = box.column(align=True)
+            for name in names:
+                column.label(text=name, icon='DOT')
+        else:
+            box.label(text="Automatic")
+        box.operator("dimred.mark_surface", icon='CHECKBOX_HLT')
+
+        layout.prop(settings, "quality")
+        layout.prop(settings, "output_dir")
+
+        column = layout.column(align=True)
+        column.scale_y = 1.4
+        column.operator("dimred.remove", icon='TRASH')
+        row = layout.row(align=True)
+        row.operator("dimred.clear", icon='X')
+        row.operator("dimred.save_hdri", icon='FILE_IMAGE')
+
+
+class DIMRED_PT_last_run(bpy.types.Panel):
+    bl_label = "Last Run"
+    bl_idname = "DIMRED_PT_last_run"
+    bl_space_type = 'VIEW_3D'
+    bl_region_type = 'UI'
+    bl_category = CATEGORY
+    bl_parent_id = "DIMRED_PT_main"
+    bl_options = {'DEFAULT_CLOSED'}
+
+    @classmethod
+    def poll(cls, context: bpy.types.Context) -> bool:
+        return bool(context.scene.dimred.last_report)
+
+    def draw(self, context: bpy.types.Context) -> None:
+        layout = self.layout
+        try:
+            report = json.loads(context.scene.dimred.last_report)
+        except json.JSONDecodeError:
+            layout.label(text="The stored report is not valid JSON", icon='ERROR')
+            return
+        if not world_layer.has_layer(context.scene.world):
+            layout.label(text="Cleared: the world shows the original", icon='INFO')
+
+        seconds = report.get("seconds", {})
+        column = layout.column(align=True)
+        for stage, value in seconds.items():
+            if isinstance(value, (int, float)):
+                column.label(text=f"{stage}: {value:.2f} s")
+        for line in _lines(report.get("skipped")):
+            layout.label(text=f"Skipped {line}", icon='FORWARD')
+        for line in _lines(report.get("warnings")):
+            layout.label(text=line, icon='ERROR')
+        for line in _lines(report.get("guards")):
+            layout.label(text=line, icon='INFO')
+
+
+def _lines(entries: object) -> list[str]:
+    """Report entries, a dict (name -> detail) or a list, as one line each."""
+    if isinstance(entries, dict):
+        return [f"{name}: {_text(detail)}" for name, detail in entries.items()]
+    if isinstance(entries, list):
+        return [_text(item) for item in entries]
+    return []
+
+
+def _text(value: object) -> str:
+    if isinstance(value, dict) and {"stage", "reason"} <= value.keys():
+        return f"{value['stage']}: {value['reason']}"
+    if isinstance(value, dict):
+        return ", ".join(f"{k}: {v}" for k, v in value.items())
+    return str(value)
+
+
+classes = (DIMRED_PT_main, DIMRED_PT_last_run)
+
+
+def register() -> None:
+    for cls in classes:
+        bpy.utils.register_class(cls)
+
+
+def unregister() -> None:
+    for cls in reversed(classes):
+        bpy.utils.unregister_class(cls)

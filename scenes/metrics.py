@@ -1,0 +1,171 @@
+"""Scores of an edited panorama against the rendered ground truth (numpy only).
+
+Inputs are lat-long panoramas (H, W, 3), row 0 at the top: `input` (rendered with the object),
+`truth` (rendered without it, same seed), `edit` (the engine's input + difference) and the
+(H, W) bool `object_mask` of pixels that see the removed object.
+
+The two renders share their random numbers, so where no path touched the object their noise is
+identical, and |input - truth| there is (nearly) zero rather than twice the noise. Scores
+compare luminance after a 3x3 box blur, which wraps around the u seam and clamps at the poles,
+so single-pixel noise (where paths differ) weighs less than the lighting change. Sums run over
+pixels, not solid angle: a panorama pixel is what the viewer sees.
+
+Region A (`lighting_region`) is where the removal visibly changed the lighting: outside the
+object mask dilated by `margin` px (2), where the blurred |Y_input - Y_truth| exceeds all of
+- `rel` (2 %) of the blurred Y_truth: smaller changes are invisible;
+- `abs_frac` (1 %) of the median blurred Y_truth: keeps dark pixels out, and scales with the
+  exposure, so a rescaled scene gives the same region;
+- `k_noise` (3) times the local noise of the blurred difference (`blurred_difference_noise`):
+  where the two renders' paths differ, their noise differs, and at 16-64 samples single
+  pixels there pass a 2 % test by chance; a noise-dominated A would pull every ratio to 1.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+_LUMA = np.array([0.2126, 0.7152, 0.0722])
+
+
+def luminance(rgb: np.ndarray) -> np.ndarray:
+    """(H, W) Rec.709 luminance Y = 0.2126 R + 0.7152 G + 0.0722 B, as float64."""
+    return np.asarray(rgb, dtype=np.float64) @ _LUMA
+
+
+def box_blur3(a: np.ndarray) -> np.ndarray:
+    """3x3 mean over the first two axes: wraps around the u seam (axis 1), clamps at the poles."""
+    a = np.asarray(a, dtype=np.float64)
+    v = np.concatenate([a[:1], a, a[-1:]], axis=0)
+    v = (v[:-2] + v[1:-1] + v[2:]) / 3.0
+    return (np.roll(v, 1, axis=1) + v + np.roll(v, -1, axis=1)) / 3.0
+
+
+def dilate(mask: np.ndarray, radius: int) -> np.ndarray:
+    """Square dilation by `radius` px: wraps around the u seam, clamps at the poles."""
+    out = np.asarray(mask, dtype=bool)
+    h = out.shape[0]
+    rows = out.copy()
+    for k in range(1, min(radius, h - 1) + 1):
+        rows[k:] |= out[:-k]
+        rows[:-k] |= out[k:]
+    out = rows.copy()
+    for k in range(1, radius + 1):
+        out |= np.roll(rows, k, axis=1) | np.roll(rows, -k, axis=1)
+    return out
+
+
+def _blurred_y(rgb: np.ndarray) -> np.ndarray:
+    return box_blur3(luminance(rgb))
+
+
+def _abs_floor(y_truth: np.ndarray, abs_frac: float) -> float:
+    return abs_frac * float(np.median(y_truth))
+
+
+def blurred_difference_noise(input: np.ndarray, truth: np.ndarray) -> np.ndarray:
+    """(H, W) local standard deviation of the noise in the 3x3-blurred Y_input - Y_truth.
+
+    Estimated from the high-pass residual d - blur(d) of the per-pixel difference d, whose
+    variance is 8/9 of the pixel noise variance for independent pixels; its local mean over
+    5x5 px, divided by the 9 pixels a 3x3 blur averages, gives the blurred difference's noise.
+    In the first and last row the clamped blur counts the edge row twice, which doubles the
+    ratio of the blurred noise's variance to the residual's (15/81 / (60/81) vs 1/9 / (8/9)).
+    """
+    d = luminance(input) - luminance(truth)
+    r = d - box_blur3(d)
+    var = box_blur3(box_blur3(r * r)) / 8.0
+    var[[0, -1]] *= 2.0
+    return np.sqrt(var)
+
+
+def lighting_region(input: np.ndarray, truth: np.ndarray, object_mask: np.ndarray,
+                    rel: float = 0.02, abs_frac: float = 0.01, k_noise: float = 3.0,
+                    margin: int = 2) -> np.ndarray:
+    """(H, W) bool region A where removing the object changed the lighting beyond noise:
+    outside the object mask dilated by `margin` px, blurred |Y_input - Y_truth| above
+    max(`rel` * blurred Y_truth, `abs_frac` * its median, `k_noise` * local noise)."""
+    yi, yt = _blurred_y(input), _blurred_y(truth)
+    threshold = np.maximum(np.maximum(rel * yt, _abs_floor(yt, abs_frac)),
+                           k_noise * blurred_difference_noise(input, truth))
+    return (np.abs(yi - yt) > threshold) & ~dilate(object_mask, margin)
+
+
+def lighting_error_ratio(input: np.ndarray, edit: np.ndarray, truth: np.ndarray,
+                         object_mask: np.ndarray, region: np.ndarray | None = None) -> float:
+    """sum_A |Y_edit - Y_truth| / sum_A |Y_input - Y_truth| (blurred Y): 1 = nothing fixed,
+    0 = exactly the truth, above 1 = worse than not editing. Raises ValueError if A is empty."""
+    if region is None:
+        region = lighting_region(input, truth, object_mask)
+    if not region.any():
+        raise ValueError("the removal changed no lighting beyond the noise (region A is empty)")
+    yi, ye, yt = _blurred_y(input), _blurred_y(edit), _blurred_y(truth)
+    return float(np.abs(ye - yt)[region].sum() / np.abs(yi - yt)[region].sum())
+
+
+def far_damage(input: np.ndarray, edit: np.ndarray, truth: np.ndarray, object_mask: np.ndarray,
+               region: np.ndarray | None = None, margin: int | None = None,
+               percentile: float = 99.9, abs_frac: float = 0.01) -> float:
+    """How much further from the truth than the input the edit gets where it should change
+    (almost) nothing: the `percentile` of (|Y_edit - Y_truth| - |Y_input - Y_truth|) /
+    Y_truth (blurred Y, Y_truth floored as in region A) over pixels farther than `margin` px
+    (default W/64, at least 4) from the object and 2 px from region A. <= 0: no damage."""
+    if region is None:
+        region = lighting_region(input, truth, object_mask)
+    if margin is None:
+        margin = max(4, input.shape[1] // 64)
+    far = ~dilate(object_mask, margin) & ~dilate(region, 2)
+    yi, ye, yt = _blurred_y(input), _blurred_y(edit), _blurred_y(truth)
+    excess = (np.abs(ye - yt) - np.abs(yi - yt)) / np.maximum(yt, _abs_floor(yt, abs_frac))
+    return float(np.percentile(excess[far], percentile))
+
+
+def chromaticity(rgb: np.ndarray) -> np.ndarray:
+    """(H, W, 3) rgb / (r + g + b) of the 3x3-blurred colour; grey where the sum is 0."""
+    c = box_blur3(rgb)
+    s = c.sum(axis=-1, keepdims=True)
+    return np.where(s > 0.0, c / np.where(s > 0.0, s, 1.0), 1.0 / 3.0)
+
+
+def bleeding_error(input: np.ndarray, edit: np.ndarray, truth: np.ndarray,
+                   object_mask: np.ndarray, region: np.ndarray | None = None) -> tuple[float, float]:
+    """Colour error in region A as (input's, edit's): the mean over A, weighted by blurred
+    Y_truth, of sum_c |chromaticity_c - chromaticity_c(truth)|. Colour bleeding from the object
+    shows as the input's error; a good edit brings its own well below it."""
+    if region is None:
+        region = lighting_region(input, truth, object_mask)
+    if not region.any():
+        raise ValueError("the removal changed no lighting beyond the noise (region A is empty)")
+    ct = chromaticity(truth)
+    w = _blurred_y(truth)[region]
+
+    def err(img: np.ndarray) -> float:
+        e = np.abs(chromaticity(img) - ct).sum(axis=-1)[region]
+        return float((e * w).sum() / w.sum())
+
+    return err(input), err(edit)
+
+
+def noise_floor(input: np.ndarray, truth: np.ndarray, object_mask: np.ndarray,
+                region: np.ndarray | None = None) -> float:
+    """The `lighting_error_ratio` of the input scaled per pixel by the 3x3 box-filtered ratio
+    Y_truth / Y_input: the best an edit that is smooth at the 3 px scale can do, i.e. the
+    noise left where the two renders' paths differ (a second seed would overstate it)."""
+    yi = luminance(input)
+    ratio = box_blur3(luminance(truth) / np.maximum(yi, np.finfo(np.float64).tiny))
+    ideal = np.asarray(input, dtype=np.float64) * ratio[..., None]
+    return lighting_error_ratio(input, ideal, truth, object_mask, region)
+
+
+def summary(input: np.ndarray, edit: np.ndarray, truth: np.ndarray,
+            object_mask: np.ndarray) -> dict[str, float]:
+    """All scores at their defaults, for reports: region size, ratio, noise floor, far
+    damage, bleeding (input and edit)."""
+    region = lighting_region(input, truth, object_mask)
+    bleed_in, bleed_edit = bleeding_error(input, edit, truth, object_mask, region)
+    return {
+        "region_pixels": int(region.sum()),
+        "lighting_error_ratio": lighting_error_ratio(input, edit, truth, object_mask, region),
+        "noise_floor": noise_floor(input, truth, object_mask, region),
+        "far_damage": far_damage(input, edit, truth, object_mask, region),
+        "bleeding_input": bleed_in,
+        "bleeding_edit": bleed_edit,
+    }

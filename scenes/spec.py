@@ -1,0 +1,378 @@
+"""Plain descriptions of the ground-truth test rooms, and the registry of named ones (no bpy).
+
+A `SceneSpec` is everything that decides the pixels of a ground-truth render: a closed
+Lambertian room, rectangular ceiling lamps, objects, the probe centre, the object to remove,
+the world's Mapping-node rotation and the Cycles settings. `key()` names its render cache.
+
+The named specs differ on purpose (room shape and placement, floor texture, lamp count, size
+and power, object kind, colour and position in the panorama) so that the engine is not tuned
+to one scene. Units are metres; colours are linear RGB albedos in [0, 1).
+"""
+from __future__ import annotations
+
+import ast
+import dataclasses
+import hashlib
+import importlib.metadata
+import json
+from dataclasses import dataclass, field
+from functools import cache
+from pathlib import Path
+from typing import Any
+
+Vec2 = tuple[float, float]
+Vec3 = tuple[float, float, float]
+
+FLOOR_PATTERNS = ("checker", "planks", "noise", "plain")
+OBJECT_KINDS = ("box", "stool", "cylinder", "sphere")
+# Names `build` gives the room, lamps, probe and camera; objects must not take them.
+RESERVED_NAMES = ("Floor", "Ceiling", "ProbeCenter", "ProbeCamera")
+RESERVED_PREFIXES = ("Wall.", "Lamp.", "LampHousing.")
+
+# Sources whose changes alter the pixels; hashed into every key so a stale cache cannot be hit.
+_RENDER_SOURCES = ("build.py", "render_job.py")
+
+
+@dataclass(frozen=True)
+class Floor:
+    """Floor albedo: `pattern` of `color1`/`color2`, `scale` metres per tile, plank or feature."""
+
+    pattern: str = "plain"
+    color1: Vec3 = (0.6, 0.6, 0.6)
+    color2: Vec3 = (0.3, 0.3, 0.3)
+    scale: float = 0.5
+
+
+@dataclass(frozen=True)
+class Room:
+    """Axis-aligned closed box from corner `lo` to corner `hi` (need not contain the origin)."""
+
+    lo: Vec3
+    hi: Vec3
+    wall_albedo: Vec3 = (0.7, 0.7, 0.68)
+    ceiling_albedo: Vec3 = (0.8, 0.8, 0.8)
+    floor: Floor = field(default_factory=Floor)
+
+
+@dataclass(frozen=True)
+class Lamp:
+    """Emitting quad in a hole of the ceiling: centre (x, y), size (x, y), radiance `strength`."""
+
+    center: Vec2
+    size: Vec2
+    strength: float
+    color: Vec3 = (1.0, 1.0, 1.0)
+
+
+@dataclass(frozen=True)
+class SceneObject:
+    """A mesh object. `size` is its bounding box (x, y, z) before the rotation about Z.
+
+    `location` is the bottom centre; its z defaults to the floor. A cylinder or sphere with
+    unequal x and y is elliptic. Stools use `seat` ('round' or 'square'), `legs` (3 or 4),
+    `leg_width` and `seat_thickness`; other kinds ignore them.
+    """
+
+    name: str
+    kind: str
+    size: Vec3
+    location: Vec3
+    albedo: Vec3 = (0.5, 0.5, 0.5)
+    rotation_z: float = 0.0
+    seat: str = "round"
+    legs: int = 4
+    leg_width: float = 0.03
+    seat_thickness: float = 0.04
+
+
+@dataclass(frozen=True)
+class Render:
+    """Cycles settings that change the pixels (the rest are fixed in `build`)."""
+
+    width: int = 256
+    height: int = 128
+    samples: int = 64
+    seed: int = 1
+    max_bounces: int = 8
+
+
+@dataclass(frozen=True)
+class SceneSpec:
+    """One ground-truth scene. `world_rotation_z` (degrees) is the Mapping node's Z rotation."""
+
+    name: str
+    room: Room
+    lamps: tuple[Lamp, ...]
+    objects: tuple[SceneObject, ...]
+    probe: Vec3
+    remove: str
+    world_rotation_z: float = 0.0
+    render: Render = field(default_factory=Render)
+
+    def __post_init__(self) -> None:
+        _validate(self)
+
+    def removed_object(self) -> SceneObject:
+        return next(o for o in self.objects if o.name == self.remove)
+
+    def with_render(self, **changes: Any) -> SceneSpec:
+        """The same scene with some `Render` fields changed (width, height, samples, ...)."""
+        return dataclasses.replace(self, render=dataclasses.replace(self.render, **changes))
+
+    def to_dict(self) -> dict[str, Any]:
+        return dataclasses.asdict(self)
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> SceneSpec:
+        room = dict(d["room"], floor=Floor(**_tuples(d["room"]["floor"])))
+        return cls(
+            name=d["name"],
+            room=Room(**_tuples(room)),
+            lamps=tuple(Lamp(**_tuples(x)) for x in d["lamps"]),
+            objects=tuple(SceneObject(**_tuples(x)) for x in d["objects"]),
+            probe=tuple(d["probe"]),
+            remove=d["remove"],
+            world_rotation_z=d["world_rotation_z"],
+            render=Render(**d["render"]),
+        )
+
+    def to_json(self) -> str:
+        return json.dumps(self.to_dict(), sort_keys=True)
+
+    @classmethod
+    def from_json(cls, text: str) -> SceneSpec:
+        return cls.from_dict(json.loads(text))
+
+    def key(self) -> str:
+        """Stable hash of every field, the render code and the bpy version (cache folder name)."""
+        h = hashlib.sha256(self.to_json().encode())
+        h.update(_render_fingerprint().encode())
+        return h.hexdigest()[:20]
+
+
+def _tuples(d: dict[str, Any]) -> dict[str, Any]:
+    # JSON turns tuples into lists; the dataclasses are frozen and hashed as tuples.
+    return {k: tuple(v) if isinstance(v, list) else v for k, v in d.items()}
+
+
+@cache
+def _render_fingerprint() -> str:
+    here = Path(__file__).resolve().parent
+    h = hashlib.sha256(importlib.metadata.version("bpy").encode())
+    for name in _RENDER_SOURCES:
+        h.update(_code_only((here / name).read_text()).encode())
+    return h.hexdigest()
+
+
+def _code_only(source: str) -> str:
+    """The syntax tree without docstrings, comments and layout: editing those keeps the cache."""
+    tree = ast.parse(source)
+    for node in ast.walk(tree):
+        body = getattr(node, "body", None)
+        if (isinstance(node, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef))
+                and body and isinstance(body[0], ast.Expr)
+                and isinstance(body[0].value, ast.Constant) and isinstance(body[0].value.value, str)):
+            node.body = body[1:] or [ast.Pass()]
+    return ast.dump(tree)
+
+
+def _validate(spec: SceneSpec) -> None:
+    names = [o.name for o in spec.objects]
+    if len(set(names)) != len(names):
+        raise ValueError(f"{spec.name}: duplicate object names {names}")
+    taken = [n for n in names if n in RESERVED_NAMES or n.startswith(RESERVED_PREFIXES)]
+    if taken:
+        raise ValueError(f"{spec.name}: object names {taken} are used by the room")
+    if spec.remove not in names:
+        raise ValueError(f"{spec.name}: object to remove {spec.remove!r} not in {names}")
+    lo, hi = spec.room.lo, spec.room.hi
+    if not all(l < p < h for l, p, h in zip(lo, spec.probe, hi)):
+        raise ValueError(f"{spec.name}: probe {spec.probe} outside the room")
+    if spec.room.floor.pattern not in FLOOR_PATTERNS:
+        raise ValueError(f"{spec.name}: floor pattern {spec.room.floor.pattern!r}")
+    for lamp in spec.lamps:
+        for c, s, l, h in zip(lamp.center, lamp.size, lo, hi):
+            if not (l < c - s / 2 and c + s / 2 < h):
+                raise ValueError(f"{spec.name}: lamp {lamp} not inside the ceiling")
+    for o in spec.objects:
+        if o.kind not in OBJECT_KINDS:
+            raise ValueError(f"{spec.name}: object kind {o.kind!r}")
+        if o.kind == "stool" and (o.seat not in ("round", "square") or o.legs not in (3, 4)):
+            raise ValueError(f"{spec.name}: stool {o.name} needs a round/square seat, 3-4 legs")
+    albedos = [spec.room.wall_albedo, spec.room.ceiling_albedo, spec.room.floor.color1,
+               spec.room.floor.color2] + [o.albedo for o in spec.objects]
+    if not all(0.0 <= c < 1.0 for a in albedos for c in a):
+        raise ValueError(f"{spec.name}: albedos must lie in [0, 1)")
+
+
+# ---------------------------------------------------------------------------------------------
+# The registry. Floor height is z = lo[2]; object locations give the bottom centre.
+
+_WOOD = Floor("planks", (0.42, 0.27, 0.15), (0.62, 0.45, 0.28), 0.18)
+_GREY = (0.5, 0.5, 0.5)
+
+
+def _on_floor(room: Room, x: float, y: float) -> Vec3:
+    return (x, y, room.lo[2])
+
+
+def _basic_room() -> Room:
+    return Room(lo=(-2.0, -1.5, 0.0), hi=(3.0, 2.5, 2.7),
+                floor=Floor("checker", (0.62, 0.62, 0.6), (0.22, 0.22, 0.24), 0.5))
+
+
+def _basic_box(name: str = "basic_box", world_rotation_z: float = 0.0) -> SceneSpec:
+    room = _basic_room()
+    return SceneSpec(
+        name=name,
+        room=room,
+        lamps=(Lamp((1.6, 1.4), (0.5, 0.5), 30.0),
+               Lamp((-0.9, -0.6), (0.6, 0.4), 25.0, (1.0, 0.93, 0.82))),
+        objects=(SceneObject("Box", "box", (0.5, 0.5, 0.5), _on_floor(room, 1.1, 1.05),
+                             _GREY, rotation_z=20.0),),
+        probe=(0.0, 0.0, 1.5),
+        remove="Box",
+        world_rotation_z=world_rotation_z,
+    )
+
+
+def _red_box() -> SceneSpec:
+    room = Room(lo=(-2.5, -2.0, 0.0), hi=(2.5, 2.0, 2.7), floor=Floor("plain", (0.8, 0.8, 0.8)))
+    return SceneSpec(
+        name="red_box",
+        room=room,
+        lamps=(Lamp((1.3, -0.6), (0.5, 0.5), 30.0), Lamp((-1.2, 1.0), (0.5, 0.5), 20.0)),
+        objects=(SceneObject("RedBox", "box", (0.6, 0.6, 0.6), _on_floor(room, 1.3, -0.6),
+                             (0.8, 0.04, 0.03)),),
+        probe=(0.0, 0.2, 1.5),
+        remove="RedBox",
+    )
+
+
+def _stool() -> SceneSpec:
+    room = Room(lo=(-1.5, -2.5, 0.0), hi=(3.0, 1.5, 2.6), floor=_WOOD)
+    return SceneSpec(
+        name="stool",
+        room=room,
+        lamps=(Lamp((1.4, -1.2), (0.4, 0.4), 40.0), Lamp((-0.5, 0.6), (0.8, 0.3), 15.0)),
+        objects=(SceneObject("Stool", "stool", (0.36, 0.36, 0.62), _on_floor(room, 1.4, -1.2),
+                             (0.45, 0.3, 0.18), rotation_z=10.0, seat="round", legs=3),),
+        probe=(0.2, -0.1, 1.45),
+        remove="Stool",
+    )
+
+
+def _wall_contact() -> SceneSpec:
+    room = Room(lo=(-3.0, -1.0, 0.0), hi=(3.0, 2.5, 3.0), wall_albedo=(0.75, 0.72, 0.62),
+                floor=Floor("checker", (0.55, 0.5, 0.45), (0.3, 0.27, 0.25), 0.3))
+    # Touching the +Y wall: the box's back face lies in the wall's plane.
+    return SceneSpec(
+        name="wall_contact",
+        room=room,
+        lamps=(Lamp((0.8, 1.6), (0.3, 0.3), 90.0), Lamp((-1.8, 0.5), (1.0, 0.5), 12.0),
+               Lamp((2.2, 0.0), (0.6, 0.6), 20.0)),
+        objects=(SceneObject("Crate", "box", (0.7, 0.45, 0.8), _on_floor(room, 0.9, 2.275),
+                             (0.55, 0.5, 0.42)),),
+        probe=(0.3, 0.4, 1.6),
+        remove="Crate",
+    )
+
+
+def _bright_lamp() -> SceneSpec:
+    room = Room(lo=(-2.2, -2.2, 0.0), hi=(2.8, 1.8, 2.7),
+                floor=Floor("noise", (0.35, 0.33, 0.3), (0.65, 0.62, 0.58), 0.25))
+    # The small lamp carries ~1000x the radiance of the big one (and ~40x its power).
+    return SceneSpec(
+        name="bright_lamp",
+        room=room,
+        lamps=(Lamp((1.2, 0.9), (0.1, 0.1), 2.0e4), Lamp((-1.0, -1.0), (0.6, 0.6), 20.0)),
+        objects=(SceneObject("Cylinder", "cylinder", (0.4, 0.4, 0.7), _on_floor(room, 1.1, 0.6),
+                             (0.5, 0.55, 0.6)),),
+        probe=(0.0, -0.3, 1.5),
+        remove="Cylinder",
+    )
+
+
+def _seam() -> SceneSpec:
+    room = Room(lo=(-3.0, -2.0, 0.0), hi=(2.0, 2.0, 2.7),
+                floor=Floor("checker", (0.6, 0.6, 0.6), (0.3, 0.32, 0.35), 0.4))
+    # Straight in -X from the probe centre: the object straddles the panorama's u = 0/1 seam.
+    return SceneSpec(
+        name="seam",
+        room=room,
+        lamps=(Lamp((-1.8, 0.3), (0.5, 0.5), 30.0), Lamp((0.8, -0.5), (0.5, 0.5), 20.0)),
+        objects=(SceneObject("Box", "box", (0.5, 0.6, 0.55), _on_floor(room, -1.6, 0.0),
+                             (0.45, 0.5, 0.45)),),
+        probe=(0.0, 0.0, 1.5),
+        remove="Box",
+    )
+
+
+def _nadir() -> SceneSpec:
+    room = Room(lo=(-2.0, -2.0, 0.0), hi=(2.5, 2.0, 2.6),
+                floor=Floor("noise", (0.5, 0.45, 0.4), (0.75, 0.72, 0.68), 0.15))
+    # About 10 degrees from straight down: the panorama's bottom rows, heavily stretched.
+    return SceneSpec(
+        name="nadir",
+        room=room,
+        lamps=(Lamp((0.3, 0.2), (0.5, 0.5), 30.0), Lamp((-1.2, -1.0), (0.4, 0.4), 20.0)),
+        objects=(SceneObject("Ball", "sphere", (0.3, 0.3, 0.3), _on_floor(room, 0.2, 0.1),
+                             (0.6, 0.45, 0.3)),),
+        probe=(0.0, 0.0, 1.4),
+        remove="Ball",
+    )
+
+
+def _second_object() -> SceneSpec:
+    room = Room(lo=(-2.5, -2.0, 0.0), hi=(2.5, 2.5, 2.8),
+                floor=Floor("checker", (0.7, 0.7, 0.7), (0.35, 0.35, 0.35), 0.4))
+    return SceneSpec(
+        name="second_object",
+        room=room,
+        lamps=(Lamp((1.0, 1.0), (0.6, 0.4), 30.0), Lamp((-1.3, -0.8), (0.5, 0.5), 20.0)),
+        objects=(SceneObject("Box", "box", (0.5, 0.5, 0.5), _on_floor(room, 1.3, 0.5), _GREY),
+                 SceneObject("Cabinet", "box", (0.5, 0.4, 1.8), _on_floor(room, 0.4, 1.5),
+                             (0.55, 0.5, 0.45), rotation_z=-15.0)),
+        probe=(0.0, 0.0, 1.5),
+        remove="Box",
+    )
+
+
+def _demo() -> SceneSpec:
+    room = Room(lo=(-2.5, -2.0, 0.0), hi=(3.0, 2.5, 2.8), wall_albedo=(0.78, 0.76, 0.72),
+                floor=_WOOD)
+    return SceneSpec(
+        name="demo",
+        room=room,
+        lamps=(Lamp((1.4, 0.6), (0.5, 0.5), 35.0, (1.0, 0.95, 0.88)),
+               Lamp((-1.0, -0.6), (0.8, 0.4), 20.0)),
+        objects=(SceneObject("Box", "box", (0.55, 0.55, 0.5), _on_floor(room, 1.5, 0.4),
+                             (0.12, 0.35, 0.6), rotation_z=25.0),
+                 SceneObject("Stool", "stool", (0.38, 0.38, 0.65), _on_floor(room, -0.6, 1.3),
+                             (0.5, 0.32, 0.2), seat="square", legs=4)),
+        probe=(0.0, 0.0, 1.5),
+        remove="Box",
+        render=Render(1024, 512, 32),
+    )
+
+
+SPECS: dict[str, SceneSpec] = {s.name: s for s in (
+    _basic_box(),
+    _red_box(),
+    _stool(),
+    _wall_contact(),
+    _bright_lamp(),
+    _seam(),
+    _nadir(),
+    _basic_box("rotated_world", world_rotation_z=70.0),
+    _second_object(),
+    _demo(),
+)}
+
+
+def get(name: str) -> SceneSpec:
+    """The named spec; `KeyError` lists the known names."""
+    try:
+        return SPECS[name]
+    except KeyError:
+        raise KeyError(f"unknown scene {name!r}; known: {', '.join(SPECS)}") from None

@@ -1,0 +1,147 @@
+"""Shared fixtures: the repository imported the way Blender imports the installed extension,
+a fresh Blender session, and a Cycles render of the world as a lat-long panorama.
+
+Blender imports an extension as a package (`bl_ext.<repo>.diminished_reality`) whose modules
+use relative imports; here the repository root becomes the package `diminished_reality`.
+"""
+from __future__ import annotations
+
+import importlib.util
+import sys
+from pathlib import Path
+from types import ModuleType
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+PACKAGE = "diminished_reality"
+
+
+def import_extension() -> ModuleType:
+    """The repository root as the package `diminished_reality` (imported once per process)."""
+    if PACKAGE not in sys.modules:
+        spec = importlib.util.spec_from_file_location(
+            PACKAGE, ROOT / "__init__.py", submodule_search_locations=[str(ROOT)]
+        )
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[PACKAGE] = module
+        spec.loader.exec_module(module)
+    return sys.modules[PACKAGE]
+
+
+@pytest.fixture(scope="session")
+def extension() -> ModuleType:
+    return import_extension()
+
+
+@pytest.fixture
+def registered(extension: ModuleType):
+    """The add-on registered for one test, on a fresh empty Blender session."""
+    import bpy
+
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    extension.register()
+    try:
+        yield extension
+    finally:
+        extension.unregister()
+
+
+@pytest.fixture
+def fresh_blender():
+    """An empty Blender session (factory settings, no objects) for a test that builds a scene."""
+    import bpy
+
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    yield bpy
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+
+
+@pytest.fixture
+def render_world(tmp_path: Path):
+    """A function that renders the current scene's world with Cycles from `origin` through an
+    equirectangular panoramic camera and returns (height, width, 3) float32, top row first.
+
+    One sample with a 0.01 px Blackman-Harris filter point-samples each pixel's centre
+    direction; the camera rotation (90, 0, -90) degrees makes the render's pixel directions
+    those of `addon.latlong.pixel_directions`. Keep sizes tiny: the machine is shared.
+    """
+    import math
+
+    import bpy
+
+    from addon.exr import read_exr
+
+    def render(width: int, height: int, origin: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> np.ndarray:
+        scene = bpy.context.scene
+        camera_data = bpy.data.cameras.new("ProbeCamera")
+        camera_data.type = 'PANO'
+        camera_data.panorama_type = 'EQUIRECTANGULAR'
+        camera_data.longitude_min, camera_data.longitude_max = -math.pi, math.pi
+        camera_data.latitude_min, camera_data.latitude_max = -math.pi / 2, math.pi / 2
+        camera = bpy.data.objects.new("ProbeCamera", camera_data)
+        scene.collection.objects.link(camera)
+        camera.location = origin
+        camera.rotation_euler = (math.pi / 2, 0.0, -math.pi / 2)
+        scene.camera = camera
+        scene.render.engine = 'CYCLES'
+        scene.cycles.device = 'CPU'
+        scene.cycles.samples = 1
+        scene.cycles.use_adaptive_sampling = False
+        scene.cycles.use_denoising = False
+        scene.cycles.pixel_filter_type = 'BLACKMAN_HARRIS'
+        scene.cycles.filter_width = 0.01
+        scene.render.threads_mode = 'FIXED'
+        scene.render.threads = 2
+        scene.render.resolution_x, scene.render.resolution_y = width, height
+        scene.render.resolution_percentage = 100
+        scene.render.use_compositing = False
+        scene.render.use_sequencer = False
+        scene.view_settings.view_transform = 'Standard'
+        settings = scene.render.image_settings
+        settings.file_format = 'OPEN_EXR'
+        settings.color_depth = '32'
+        settings.color_mode = 'RGB'
+        scene.render.filepath = str(tmp_path / "render.exr")
+        bpy.ops.render.render(write_still=True)
+        bpy.data.objects.remove(camera)
+        return read_exr(tmp_path / "render.exr")
+
+    return render
+
+
+@pytest.fixture
+def panorama_world(fresh_blender):
+    """A function that makes the scene's world show `image` through an Environment Texture
+    (Closest interpolation, so a render shows single texels); with `mapping` = (type,
+    rotation, scale) a Texture Coordinate > Mapping chain feeds its vector. Returns the world's
+    node tree."""
+    bpy = fresh_blender
+
+    def build(image, mapping: tuple[str, tuple, tuple] | None = None):
+        world = bpy.data.worlds.new("Probe")
+        bpy.context.scene.world = world
+        if world.node_tree is None:
+            world.use_nodes = True  # Blender 4.x creates worlds without a node tree
+        tree = world.node_tree
+        tree.nodes.clear()
+        output = tree.nodes.new("ShaderNodeOutputWorld")
+        background = tree.nodes.new("ShaderNodeBackground")
+        environment = tree.nodes.new("ShaderNodeTexEnvironment")
+        environment.image = image
+        environment.interpolation = 'Closest'
+        tree.links.new(environment.outputs["Color"], background.inputs["Color"])
+        tree.links.new(background.outputs["Background"], output.inputs["Surface"])
+        if mapping is not None:
+            kind, rotation, scale = mapping
+            coordinates = tree.nodes.new("ShaderNodeTexCoord")
+            node = tree.nodes.new("ShaderNodeMapping")
+            node.vector_type = kind
+            node.inputs["Rotation"].default_value = rotation
+            node.inputs["Scale"].default_value = scale
+            tree.links.new(coordinates.outputs["Generated"], node.inputs["Vector"])
+            tree.links.new(node.outputs["Vector"], environment.inputs["Vector"])
+        return tree
+
+    return build

@@ -1,0 +1,171 @@
+"""End-to-end smoke test of the built extension on Blender 4.2 LTS (bpy 4.2, Python 3.11, numpy 1.26).
+
+`./dev test` runs it as `.venv311/bin/python tests/smoke_blender42.py [ZIP]`. It builds the
+extension zip with Blender 4.2's own `blender_ext.py` (or takes ZIP), installs and enables it
+into a throw-away user profile, and removes the box from a tiny procedural room twice: through
+the installed package's `blender -c dimred` command function and through `bpy.ops.dimred.remove`.
+Each step needs the ones before it, so the first failure ends the run. The closing line is
+`smoke: N passed, N failed`; the exit status is non-zero when a step failed.
+"""
+from __future__ import annotations
+
+import importlib
+import importlib.util
+import json
+import os
+import shutil
+import sys
+import tempfile
+import traceback
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+PACKAGE = "bl_ext.user_default.diminished_reality"
+OPERATORS = ("set_probe_center", "mark_remove", "mark_surface", "remove", "clear", "save_hdri")
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import tiny_scene  # noqa: E402  (next to this script, not a package)
+
+
+def build_zip(out_dir: Path) -> Path:
+    spec = importlib.util.spec_from_file_location("build_extension", ROOT / "scripts" / "build_extension.py")
+    build_extension = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(build_extension)
+    # The bpy of this interpreter is 4.2: its blender_ext.py validates the manifest for 4.2.
+    (path,) = build_extension.build(out_dir)
+    return path
+
+
+def install(zip_path: Path) -> None:
+    import bpy
+
+    result = bpy.ops.extensions.package_install_files(
+        filepath=str(zip_path), repo="user_default", enable_on_install=True
+    )
+    assert result == {'FINISHED'}, result
+    assert PACKAGE in bpy.context.preferences.addons, "the extension was installed but not enabled"
+    repo = next(r for r in bpy.context.preferences.extensions.repos if r.module == "user_default")
+    installed = Path(repo.directory) / "diminished_reality"
+    assert not (installed / "tests").exists() and (installed / "addon" / "latlong.py").is_file()
+    # Blender extracts the wheel matching its own Python (cp311 here) next to the repositories.
+    site = Path(os.environ["BLENDER_USER_RESOURCES"]) / "extensions" / ".local"
+    assert list(site.rglob("OpenEXR.cpython-311-*.so")), f"no cp311 OpenEXR extracted under {site}"
+
+
+def registered() -> None:
+    import bpy
+
+    for name in OPERATORS:
+        assert hasattr(bpy.types, f"DIMRED_OT_{name}"), name
+        assert getattr(bpy.ops.dimred, name).get_rna_type().description, name
+    assert hasattr(bpy.types.Scene, "dimred")
+    assert importlib.import_module(PACKAGE)._cli_handle is not None
+
+
+def command_function() -> Callable[[list[str]], int]:
+    command = importlib.import_module(f"{PACKAGE}.addon.cli").blender_command
+    assert callable(command)
+    return command
+
+
+def open_tiny_scene(work: Path) -> tuple[Path, Path]:
+    """Write the HDRI and the .blend, then open it as `blender -b SCENE.blend` would."""
+    import bpy
+
+    hdri_path = work / "room.exr"
+    tiny_scene.write_exr(hdri_path, tiny_scene.synthetic_hdri(64, 32))
+    # Not read_homefile/read_factory_settings: those would reload the preferences and with them
+    # the list of enabled add-ons.
+    for obj in list(bpy.data.objects):
+        bpy.data.objects.remove(obj)
+    tiny_scene.build_scene(hdri_path)
+    blend = work / "room.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(blend))
+    bpy.ops.wm.open_mainfile(filepath=str(blend))
+    return blend, hdri_path
+
+
+def check_outputs(out: Path, hdri_path: Path) -> None:
+    for name in ("difference.exr", "edited.exr", "report.json"):
+        assert (out / name).is_file(), f"{name} was not written"
+    hdri = tiny_scene.read_exr(hdri_path)
+    difference = tiny_scene.read_exr(out / "difference.exr")
+    edited = tiny_scene.read_exr(out / "edited.exr")
+    assert difference.shape == edited.shape == hdri.shape, (difference.shape, edited.shape, hdri.shape)
+    assert np.isfinite(difference).all() and np.isfinite(edited).all()
+    np.testing.assert_allclose(edited, hdri + difference, rtol=1e-5, atol=1e-5)
+    assert np.abs(difference).max() > 0, "the difference is zero: nothing was removed"
+    report = json.loads((out / "report.json").read_text())
+    assert "total" in report["seconds"], report.get("seconds")
+
+
+def command_run(command: Callable[[list[str]], int], work: Path, hdri_path: Path) -> None:
+    out = work / "command"
+    center = [str(c) for c in tiny_scene.CENTER]
+    code = command(["remove", "--object", "Box", "--out", str(out), "--quality", "draft", "--center", *center])
+    assert code == 0, f"exit code {code}"
+    check_outputs(out, hdri_path)
+
+
+def operator_run(blend: Path) -> None:
+    import bpy
+
+    world_layer = importlib.import_module(f"{PACKAGE}.operators.world_layer")
+    bpy.ops.wm.open_mainfile(filepath=str(blend))
+    scene = bpy.context.scene
+    settings = scene.dimred
+    settings.target = bpy.data.objects["Box"]
+    settings.quality = "draft"
+    bpy.ops.dimred.remove()
+    assert world_layer.has_layer(scene.world), "Remove did not add the world layer"
+    difference = world_layer.image_rgb(world_layer.layer_image(scene.world))
+    assert difference.shape == (32, 64, 3) and np.isfinite(difference).all()
+    assert json.loads(settings.last_report)["seconds"]
+    bpy.ops.dimred.clear()
+    assert not world_layer.has_layer(scene.world)
+
+
+def main(argv: list[str]) -> int:
+    work = Path(tempfile.mkdtemp(prefix="dimred-smoke-"))
+    # Before bpy is imported: Blender reads its user folders once, at start-up.
+    os.environ["BLENDER_USER_RESOURCES"] = str(work / "user")
+    import bpy
+
+    print(f"smoke: Blender {bpy.app.version_string}, Python {sys.version.split()[0]}, numpy {np.__version__}")
+    passed = failed = 0
+
+    def step(name: str, fn: Callable, *args):
+        nonlocal passed, failed
+        try:
+            value = fn(*args)
+        except Exception:
+            failed += 1
+            print(f"FAIL {name}\n{traceback.format_exc()}", flush=True)
+            raise
+        passed += 1
+        print(f"ok   {name}", flush=True)
+        return value
+
+    try:
+        zip_path = Path(argv[0]).resolve() if argv else step("build the zip with 4.2's blender_ext", build_zip, work)
+        step("install and enable the zip", install, zip_path)
+        step("operators and command registered", registered)
+        command = step("blender_command importable from the installed package", command_function)
+        blend, hdri_path = step("tiny scene opened", open_tiny_scene, work)
+        step("blender -c dimred remove: files written and finite", command_run, command, work, hdri_path)
+        step("bpy.ops.dimred.remove and clear", operator_run, blend)
+    except Exception:
+        pass  # step() printed it; every later step depends on this one
+    if failed:
+        print(f"smoke: files kept in {work}")
+    else:
+        shutil.rmtree(work, ignore_errors=True)
+    print(f"smoke: {passed} passed, {failed} failed")
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
