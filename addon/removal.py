@@ -50,6 +50,13 @@ def _cancel_check(cancel: Callable[[], bool] | None) -> Callable[[], None]:
     return check
 
 
+def _inset(points: np.ndarray, tris: np.ndarray) -> np.ndarray:
+    """Lattice points moved a hair into their triangle: a receiver exactly on the edge between
+    floor and wall sees the wall edge-on (form factor 0) while a receiver 1 mm away sees it
+    fill half its hemisphere; the pixels the lattice stands for are all inside."""
+    return points + 1e-3 * (tris.mean(axis=1) - points)
+
+
 def _interp(values: np.ndarray, corners: np.ndarray, weights: np.ndarray) -> np.ndarray:
     return np.einsum("nk,nkc->nc", weights, values[corners])
 
@@ -67,10 +74,10 @@ class _Room:
     areas: np.ndarray  # (P,)
     t_with: np.ndarray  # (R, P) receiver transport with the object
     t_without: np.ndarray  # (R, P) ... and without it
-    patch_rows: np.ndarray  # (P, 3) receiver rows averaged for each patch
+    patch_rows: np.ndarray  # (P,) receiver row of each patch's centroid
 
     def patch_mean(self, receiver_values: np.ndarray) -> np.ndarray:
-        return receiver_values[self.patch_rows].mean(axis=1)
+        return receiver_values[self.patch_rows]
 
 
 class _Removal:
@@ -123,16 +130,18 @@ class _Removal:
         areas = geo.areas[lat.patch_tri] / levels[lat.patch_tri] ** 2
         on_target = target_tri[lat.patch_tri]
 
-        # Receivers: the lattice vertices of the room, and one centroid per patch of the removed
-        # object (only its patches' means are needed, and it may have many small triangles).
+        # Receivers: the lattice vertices of the room (pixels interpolate between them), and the
+        # centroid of every patch (a patch's mean: a vertex on the floor-wall edge would see the
+        # wall fill half its hemisphere and overstate the coupling of the whole patch).
         room_vertex = ~target_tri[lat.vertex_tri]
         vertex_row = np.full(len(lat.vertices), 0, dtype=np.int64)
         vertex_row[room_vertex] = np.arange(room_vertex.sum())
-        target_patches = np.flatnonzero(on_target)
-        patch_rows = vertex_row[lat.patch_corners]
-        patch_rows[target_patches] = (room_vertex.sum() + np.arange(len(target_patches)))[:, None]
-        receivers = np.concatenate([lat.vertices[room_vertex], ptris[target_patches].mean(axis=1)])
-        receiver_normals = np.concatenate([geo.normals[lat.vertex_tri[room_vertex]], pnorm[target_patches]])
+        patch_rows = room_vertex.sum() + np.arange(len(areas))
+        receivers = np.concatenate([
+            _inset(lat.vertices[room_vertex], geo.triangles[lat.vertex_tri[room_vertex]]),
+            ptris.mean(axis=1),
+        ])
+        receiver_normals = np.concatenate([geo.normals[lat.vertex_tri[room_vertex]], pnorm])
         patch_h, corners_h, self.weights_h = lat.locate(self.tri_h, self.hits.bary.reshape(-1, 2)[self.hp])
         self.corners_h = vertex_row[corners_h]
         self.patch_h = patch_h
@@ -169,7 +178,7 @@ class _Removal:
         t_with, t_without = transport(receivers, receiver_normals, senders, self.occ_removed, self.occ_others, self.check)
 
         def mean(v):
-            return v[patch_rows].mean(axis=1)
+            return v[patch_rows]
 
         e = mean(t_with @ b)
         e_floor = 1e-9 * max(float((e @ LUMA).max()), 1e-30)
@@ -285,7 +294,8 @@ class _Removal:
             needed, inverse = np.unique(corners, return_inverse=True)
             inverse = inverse.reshape(corners.shape)
             self.check()
-            tf, tf_w = transport(fine.vertices[needed], geo.normals[fine.vertex_tri[needed]], room.senders,
+            tf, tf_w = transport(_inset(fine.vertices[needed], geo.triangles[fine.vertex_tri[needed]]),
+                                 geo.normals[fine.vertex_tri[needed]], room.senders,
                                  self.occ_removed, self.occ_others, self.check)
             self.rep.info["fine_vertices"] = int(len(needed))
             e_pix[ni] = _interp(tf @ b, inverse, weights)

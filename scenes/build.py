@@ -138,10 +138,14 @@ def _room(scene: bpy.types.Scene, room: Room, lamps: Sequence[Lamp]) -> None:
     # Quads wound so that their normals point into the room.
     _quad_object(scene, "Floor", [(x0, y0, z0), (x1, y0, z0), (x1, y1, z0), (x0, y1, z0)],
                  _floor_material(room.floor))
-    _quad_object(scene, "Wall.West", [(x0, y0, z0), (x0, y1, z0), (x0, y1, z1), (x0, y0, z1)], walls)
-    _quad_object(scene, "Wall.East", [(x1, y0, z0), (x1, y0, z1), (x1, y1, z1), (x1, y1, z0)], walls)
-    _quad_object(scene, "Wall.South", [(x0, y0, z0), (x0, y0, z1), (x1, y0, z1), (x1, y0, z0)], walls)
-    _quad_object(scene, "Wall.North", [(x0, y1, z0), (x1, y1, z0), (x1, y1, z1), (x0, y1, z1)], walls)
+    _quad_object(scene, "Wall.West",
+                 [(x0, y0, z0), (x0, y1, z0), (x0, y1, z1), (x0, y0, z1)], walls)
+    _quad_object(scene, "Wall.East",
+                 [(x1, y0, z0), (x1, y0, z1), (x1, y1, z1), (x1, y1, z0)], walls)
+    _quad_object(scene, "Wall.South",
+                 [(x0, y0, z0), (x0, y0, z1), (x1, y0, z1), (x1, y0, z0)], walls)
+    _quad_object(scene, "Wall.North",
+                 [(x0, y1, z0), (x1, y1, z0), (x1, y1, z1), (x0, y1, z1)], walls)
     _ceiling(scene, room, lamps)
     housing = _diffuse("LampHousing", (0.0, 0.0, 0.0))
     for i, lamp in enumerate(lamps, start=1):
@@ -231,7 +235,8 @@ def _stool(bm: bmesh.types.BMesh, spec: SceneObject) -> None:
         a = math.radians(45.0 + 360.0 * k / spec.legs)
         if spec.seat == "square" and spec.legs == 4:
             # Square seat: legs in the corners, inset by 1.5 leg widths.
-            x, y = math.copysign(sx / 2 - 1.5 * w, math.cos(a)), math.copysign(sy / 2 - 1.5 * w, math.sin(a))
+            x, y = (math.copysign(sx / 2 - 1.5 * w, math.cos(a)),
+                    math.copysign(sy / 2 - 1.5 * w, math.sin(a)))
         else:
             x, y = (sx / 2 - 1.5 * w) * math.cos(a), (sy / 2 - 1.5 * w) * math.sin(a)
         _box(bm, (x, y, 0.0), (w, w, sz - t))

@@ -126,7 +126,8 @@ def chromaticity(rgb: np.ndarray) -> np.ndarray:
 
 
 def bleeding_error(input: np.ndarray, edit: np.ndarray, truth: np.ndarray,
-                   object_mask: np.ndarray, region: np.ndarray | None = None) -> tuple[float, float]:
+                   object_mask: np.ndarray,
+                   region: np.ndarray | None = None) -> tuple[float, float]:
     """Colour error in region A as (input's, edit's): the mean over A, weighted by blurred
     Y_truth, of sum_c |chromaticity_c - chromaticity_c(truth)|. Colour bleeding from the object
     shows as the input's error; a good edit brings its own well below it."""

@@ -58,7 +58,8 @@ def render_pair(spec: SceneSpec, cache_root: Path = CACHE_ROOT,
     return paths
 
 
-def render_world(blend: str | Path, out_exr: str | Path, timeout: float | None = None) -> np.ndarray:
+def render_world(blend: str | Path, out_exr: str | Path,
+                 timeout: float | None = None) -> np.ndarray:
     """Render the world of a saved scene from its probe centre with the standard panoramic
     camera (see `scenes.render_job`), write `out_exr` and return its pixels (not cached)."""
     _job(["world", str(Path(blend).resolve()), str(Path(out_exr).resolve())],
@@ -76,7 +77,8 @@ def _job(args: list[str], what: str, timeout: float | None) -> None:
         raise RuntimeError(f"{what} failed (exit {proc.returncode}):\n{tail}")
 
 
-def load_pair(spec: SceneSpec, cache_root: Path = CACHE_ROOT) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def load_pair(spec: SceneSpec,
+              cache_root: Path = CACHE_ROOT) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(input, truth, mask) of `spec`, rendering first if needed: (H, W, 3) float32 top row
     first, and the (H, W) bool mask of the removed object."""
     paths = render_pair(spec, cache_root)

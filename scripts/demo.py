@@ -56,12 +56,15 @@ def main() -> int:
         f"{k} {times[k]:.1f} ({times[k + '_cpu']:.0f} CPU)" for k in ("input", "truth", "mask")))
 
     OUT.mkdir(parents=True, exist_ok=True)
+    # A failed run must not leave an older run's results looking current.
+    for stale in ("after.exr", "difference.exr", "side_by_side.png"):
+        (OUT / stale).unlink(missing_ok=True)
     shutil.copyfile(paths["input"], OUT / "before.exr")
     shutil.copyfile(paths["truth"], OUT / "truth.exr")
     removal = OUT / "removal"
     cmd = [sys.executable, "-m", "addon.cli", "remove", str(paths["blend"]),
            "--object", scene.remove, "--out", str(removal), "--quality", args.quality]
-    print("  $ " + " ".join(cmd[1:]), flush=True)
+    print("  $ python " + " ".join(cmd[1:]), flush=True)
     t = time.perf_counter()
     proc = subprocess.run(cmd, cwd=REPO, capture_output=True, text=True)
     seconds = time.perf_counter() - t
@@ -75,10 +78,12 @@ def main() -> int:
 
     before, truth, mask = read_exr(paths["input"]), read_exr(paths["truth"]), np.load(paths["mask"])
     after = read_exr(OUT / "after.exr")
-    write_png(OUT / "side_by_side.png", _side_by_side([before, after, truth], auto_exposure(before)))
+    panels = _side_by_side([before, after, truth], auto_exposure(before))
+    write_png(OUT / "side_by_side.png", panels)
     report = json.loads((removal / "report.json").read_text())
     scores = metrics.summary(before, after, truth, mask)
-    print(f"  removal took {seconds:.1f} s (report total {report.get('seconds', {}).get('total', float('nan')):.1f} s)")
+    total = report.get("seconds", {}).get("total", float("nan"))
+    print(f"  removal took {seconds:.1f} s (report total {total:.1f} s)")
     for item in report.get("skipped", []):
         print(f"  skipped {item.get('stage')}: {item.get('reason')}")
     for warning in report.get("warnings", []):
@@ -87,7 +92,8 @@ def main() -> int:
           f"(1 = unedited, 0 = truth; noise floor {scores['noise_floor']:.3f}) "
           f"over {scores['region_pixels']} px")
     print(f"  far damage {scores['far_damage']:+.4f} (<= 0: nothing made worse away from the box)")
-    print(f"  colour error {scores['bleeding_input']:.4f} before -> {scores['bleeding_edit']:.4f} after")
+    print(f"  colour error {scores['bleeding_input']:.4f} before -> "
+          f"{scores['bleeding_edit']:.4f} after")
     print(f"wrote {', '.join(sorted(p.name for p in OUT.iterdir() if p.is_file()))} in {OUT}")
     return 0
 
