@@ -1,0 +1,70 @@
+"""Removal checked against physics: Cycles renders of each scene with and without the object.
+
+Each scene goes through the command line exactly as a user runs it (`python -m addon.cli
+remove scene.blend --object NAME --out DIR`); the edit is compared with the render without
+the object over region A (where the lighting changed beyond noise, outside the object).
+Test renders are 256x128 at 64 samples, so their Monte Carlo noise floor (`noise_floor`, the
+error left by the best edit smooth at the 3 px scale) is part of every ratio measured here.
+"""
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from scenes import metrics as M
+from scenes import spec as S
+from scenes.images import read_exr
+from scenes.render import REPO, render_pair
+
+LIGHTING = ["basic_box", "red_box", "stool", "wall_contact", "bright_lamp", "seam", "rotated_world", "second_object"]
+# The figure the issue names (0.2 at 1024x512); at test size the noise floor adds to it.
+BOUND = 0.2
+FAR_DAMAGE = 0.08
+
+
+def _remove(name: str, tmp_path, quality: str = "balanced"):
+    spec = S.get(name)
+    paths = render_pair(spec)
+    out = tmp_path / "out"
+    proc = subprocess.run(
+        [sys.executable, "-m", "addon.cli", "remove", str(paths["blend"]), "--object", spec.remove,
+         "--out", str(out), "--quality", quality],
+        cwd=REPO, capture_output=True, text=True, timeout=900,
+    )
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    report = json.loads((out / "report.json").read_text())
+    return (read_exr(paths["input"]), read_exr(out / "edited.exr"), read_exr(paths["truth"]),
+            np.load(paths["mask"]), read_exr(out / "difference.exr"), report)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", LIGHTING)
+def test_removal_recovers_the_lighting_without_the_object(name, tmp_path):
+    inp, edit, truth, mask, diff, report = _remove(name, tmp_path)
+    assert np.isfinite(diff).all() and np.isfinite(edit).all()
+    ratio = M.lighting_error_ratio(inp, edit, truth, mask)
+    floor = M.noise_floor(inp, truth, mask)
+    print(f"{name}: ratio {ratio:.3f}, noise floor {floor:.3f}, {report['seconds']['total']:.1f} s")
+    assert ratio <= BOUND + floor, f"{name}: {ratio:.3f} of the lighting error is left (noise floor {floor:.3f})"
+    assert M.far_damage(inp, edit, truth, mask) <= FAR_DAMAGE
+    assert set(report["seconds"]) >= {"trace", "radiosity", "propagation", "local", "total"}
+    assert report["hidden_region_filled"] is False and report["warnings"]
+
+
+@pytest.mark.slow
+def test_colour_bleeding_of_a_red_box_is_removed(tmp_path):
+    inp, edit, truth, mask, _, _ = _remove("red_box", tmp_path)
+    before, after = M.bleeding_error(inp, edit, truth, mask)
+    assert after < 0.5 * before
+
+
+@pytest.mark.slow
+def test_object_straight_below_the_probe_gives_finite_output(tmp_path):
+    inp, edit, truth, mask, diff, report = _remove("nadir", tmp_path, quality="draft")
+    assert np.isfinite(diff).all()
+    assert M.lighting_error_ratio(inp, edit, truth, mask) < 1.0
+    assert report["hidden_pixels"] > 0
