@@ -1,0 +1,62 @@
+"""Run time of a removal per stage and quality preset, on a rendered 1024x512 scene.
+
+Prints a table (seconds per stage, and the lighting error ratio against the Cycles truth).
+The scene is the `basic_box` spec (a 0.5 m box) rendered at 1024x512; the render is cached
+under .cache/groundtruth, so only the first run pays for Cycles. Timings on a shared machine
+are noisy: compare presets within one run.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from scenes import metrics as M  # noqa: E402
+from scenes import spec as S  # noqa: E402
+from scenes.render import render_pair  # noqa: E402
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--scene", default="basic_box")
+    ap.add_argument("--width", type=int, default=1024)
+    ap.add_argument("--samples", type=int, default=16)
+    ap.add_argument("--presets", default="draft,balanced,final")
+    args = ap.parse_args()
+    spec = S.get(args.scene).with_render(width=args.width, height=args.width // 2, samples=args.samples)
+    paths = render_pair(spec)
+
+    import bpy  # noqa: F401  (the bridge needs Blender; imported after rendering in a subprocess)
+
+    from addon import bridge
+    from addon.cli import open_blend
+    from addon.pipeline import remove_object
+    from scenes.images import read_exr
+
+    open_blend(str(paths["blend"]))
+    t0 = time.perf_counter()
+    scene = bridge.read_scene(bpy.context.scene)
+    read_s = time.perf_counter() - t0
+    inp, truth, mask = read_exr(paths["input"]), read_exr(paths["truth"]), np.load(paths["mask"])
+    floor = M.noise_floor(inp, truth, mask)
+    rows = []
+    for preset in args.presets.split(","):
+        r = remove_object(scene, spec.remove, quality=preset)
+        ratio = M.lighting_error_ratio(inp, r.edited, truth, mask)
+        rows.append((preset, r.report["seconds"], ratio))
+    stages = [k for k in rows[0][1] if k != "total"]
+    print(f"scene {args.scene} {args.width}x{args.width // 2} @ {args.samples} spp; read_scene {read_s:.2f} s;"
+          f" noise floor {floor:.3f}")
+    print("| preset | " + " | ".join(stages) + " | total s | error ratio |")
+    print("|---" * (len(stages) + 3) + "|")
+    for preset, sec, ratio in rows:
+        print(f"| {preset} | " + " | ".join(f"{sec[k]:.2f}" for k in stages) + f" | {sec['total']:.2f} | {ratio:.3f} |")
+
+
+if __name__ == "__main__":
+    main()
