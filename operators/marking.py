@@ -98,12 +98,4 @@ class DIMRED_OT_mark_surface(bpy.types.Operator):
 
 classes = (DIMRED_OT_set_probe_center, DIMRED_OT_mark_remove, DIMRED_OT_mark_surface)
 
-
-def register() -> None:
-    for cls in classes:
-        bpy.utils.register_class(cls)
-
-
-def unregister() -> None:
-    for cls in reversed(classes):
-        bpy.utils.unregister_class(cls)
+register, unregister = bpy.utils.register_classes_factory(classes)

@@ -188,12 +188,4 @@ class DIMRED_OT_save_hdri(bpy.types.Operator):
 
 classes = (DIMRED_OT_remove, DIMRED_OT_clear, DIMRED_OT_save_hdri)
 
-
-def register() -> None:
-    for cls in classes:
-        bpy.utils.register_class(cls)
-
-
-def unregister() -> None:
-    for cls in reversed(classes):
-        bpy.utils.unregister_class(cls)
+register, unregister = bpy.utils.register_classes_factory(classes)

@@ -111,12 +111,4 @@ def _text(value: object) -> str:
 
 classes = (DIMRED_PT_main, DIMRED_PT_last_run)
 
-
-def register() -> None:
-    for cls in classes:
-        bpy.utils.register_class(cls)
-
-
-def unregister() -> None:
-    for cls in reversed(classes):
-        bpy.utils.unregister_class(cls)
+register, unregister = bpy.utils.register_classes_factory(classes)
