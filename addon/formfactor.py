@@ -52,6 +52,34 @@ def _clip_and_integrate(rel: np.ndarray, n: np.ndarray, eps: float) -> np.ndarra
     return np.where(any_valid, f, 0.0)
 
 
+def _whole_triangle(rel: np.ndarray, n: np.ndarray) -> np.ndarray:
+    """Lambert's formula for triangles (P, 3, 3) wholly above the tangent plane: no clipping."""
+    a = rel / np.linalg.norm(rel, axis=-1, keepdims=True)
+    b = a[:, [1, 2, 0]]
+    cr = np.cross(a, b)
+    crn = np.linalg.norm(cr, axis=-1)
+    angle = np.arctan2(crn, np.einsum("pkc,pkc->pk", a, b))
+    proj = np.einsum("pkc,pc->pk", cr, n)
+    contrib = np.where(crn > 1e-300, angle * proj / np.where(crn > 1e-300, crn, 1.0), 0.0)
+    return np.abs(contrib.sum(axis=1)) / (2.0 * np.pi)
+
+
+def _pairs(rel: np.ndarray, n: np.ndarray, sender_normals: np.ndarray | None, eps: float) -> np.ndarray:
+    """Form factors of rows rel (P, 3, 3) with receiver normals n (P, 3); most pairs need no clip."""
+    h = np.einsum("pkc,pc->pk", rel, n)
+    above = h > eps
+    some = above.any(axis=1)
+    if sender_normals is not None:
+        some &= np.einsum("pc,pc->p", -rel[:, 0, :], sender_normals) > 0.0
+    whole = some & above.all(axis=1)
+    part = some & ~whole
+    f = np.zeros(len(rel))
+    f[whole] = _whole_triangle(rel[whole], n[whole])
+    if part.any():
+        f[part] = _clip_and_integrate(rel[part], n[part], eps)
+    return f
+
+
 def point_to_triangle(
     points: np.ndarray,
     normals: np.ndarray,
@@ -71,17 +99,14 @@ def point_to_triangle(
     out = np.zeros((r, s))
     if r == 0 or s == 0:
         return out
+    sn = None if sender_normals is None else np.asarray(sender_normals, dtype=np.float64)
     rows_per_chunk = max(1, _CHUNK // s)
     for r0 in range(0, r, rows_per_chunk):
         x = points[r0 : r0 + rows_per_chunk]
-        nx = normals[r0 : r0 + rows_per_chunk]
-        rel = triangles[None, :, :, :] - x[:, None, None, :]
-        nn = np.broadcast_to(nx[:, None, :], (len(x), s, 3))
-        f = _clip_and_integrate(rel.reshape(-1, 3, 3), nn.reshape(-1, 3), eps).reshape(len(x), s)
-        if sender_normals is not None:
-            facing = np.einsum("rsc,sc->rs", -rel[:, :, 0, :], sender_normals) > 0.0
-            f = np.where(facing, f, 0.0)
-        out[r0 : r0 + len(x)] = f
+        rel = (triangles[None, :, :, :] - x[:, None, None, :]).reshape(-1, 3, 3)
+        nn = np.repeat(normals[r0 : r0 + rows_per_chunk], s, axis=0)
+        snn = None if sn is None else np.tile(sn, (len(x), 1))
+        out[r0 : r0 + len(x)] = _pairs(rel, nn, snn, eps).reshape(len(x), s)
     return out
 
 
@@ -94,8 +119,6 @@ def paired_point_to_triangle(
     for i0 in range(0, len(points), _CHUNK):
         sl = slice(i0, i0 + _CHUNK)
         rel = np.asarray(triangles[sl], dtype=np.float64) - points[sl, None, :]
-        f = _clip_and_integrate(rel, np.asarray(normals[sl], dtype=np.float64), 1e-9)
-        if sender_normals is not None:
-            f = np.where(np.einsum("pc,pc->p", -rel[:, 0, :], sender_normals[sl]) > 0.0, f, 0.0)
-        out[sl] = f
+        sn = None if sender_normals is None else np.asarray(sender_normals[sl], dtype=np.float64)
+        out[sl] = _pairs(rel, np.asarray(normals[sl], dtype=np.float64), sn, 1e-9)
     return out

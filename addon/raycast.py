@@ -19,6 +19,7 @@ _BATCH_PIXELS = 1 << 21
 _CLUSTER = 16
 _PAIR_CHUNK = 40_000
 _SEG_CHUNK = 200_000
+_END_GAP = 30.0  # segment ends stop this many tolerances short of the surfaces they join
 
 
 @dataclass
@@ -156,7 +157,11 @@ def _slab(origin: np.ndarray, inv_dir: np.ndarray, lo: np.ndarray, hi: np.ndarra
 
 
 class Occluders:
-    """Triangles that can block light, grouped for fast segment queries."""
+    """Triangles that can block light, grouped for fast segment queries.
+
+    Segments stop `_END_GAP` tolerances short of both ends, more than the boxes' margin: a
+    segment ending on a lamp set into a housing then never even enters the housing's box.
+    """
 
     def __init__(self, triangles: np.ndarray, tri_object: np.ndarray, eps: float) -> None:
         self.eps = eps
@@ -166,24 +171,20 @@ class Occluders:
             cen = tris.mean(axis=1)
             lo_o, hi_o = tris.reshape(-1, 3).min(axis=0), tris.reshape(-1, 3).max(axis=0)
             q = ((cen - lo_o) / np.maximum(hi_o - lo_o, 1e-12) * 1023).astype(np.int64)
-            order = np.argsort(_morton(q))
-            tris = tris[order]
+            tris = tris[np.argsort(_morton(q))]
             n_cl = -(-len(tris) // _CLUSTER)
-            pad = n_cl * _CLUSTER - len(tris)
-            v0 = np.concatenate([tris[:, 0], np.zeros((pad, 3))]).reshape(n_cl, _CLUSTER, 3)
-            e1 = np.concatenate([tris[:, 1] - tris[:, 0], np.zeros((pad, 3))]).reshape(n_cl, _CLUSTER, 3)
-            e2 = np.concatenate([tris[:, 2] - tris[:, 0], np.zeros((pad, 3))]).reshape(n_cl, _CLUSTER, 3)
-            flat = np.concatenate([tris, np.repeat(tris[-1:], pad, axis=0)]).reshape(n_cl, _CLUSTER * 3, 3)
-            margin = eps
+            # Padding repeats the last triangle: a duplicate cannot change "any hit".
+            tris = np.concatenate([tris, np.repeat(tris[-1:], n_cl * _CLUSTER - len(tris), axis=0)])
+            flat = tris.reshape(n_cl, _CLUSTER * 3, 3)
+            # Structure of arrays, (9, n_cl, K): v0, e1, e2 by component, for gathers per cluster.
+            soa = np.concatenate([tris[:, 0], tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0]], axis=1)
             self.objects.append(
                 dict(
-                    lo=lo_o - margin,
-                    hi=hi_o + margin,
-                    clo=flat.min(axis=1) - margin,
-                    chi=flat.max(axis=1) + margin,
-                    v0=v0,
-                    e1=e1,
-                    e2=e2,
+                    lo=lo_o - eps,
+                    hi=hi_o + eps,
+                    clo=flat.min(axis=1) - eps,
+                    chi=flat.max(axis=1) + eps,
+                    soa=np.ascontiguousarray(soa.T.reshape(9, n_cl, _CLUSTER)),
                 )
             )
 
@@ -199,7 +200,7 @@ class Occluders:
     def _blocked_chunk(self, p0: np.ndarray, p1: np.ndarray) -> np.ndarray:
         d = p1 - p0
         length = np.linalg.norm(d, axis=1)
-        tmin = np.minimum(self.eps / np.maximum(length, 1e-300), 0.5)
+        tmin = np.minimum(_END_GAP * self.eps / np.maximum(length, 1e-300), 0.5)
         tmax = 1.0 - tmin
         with np.errstate(divide="ignore"):
             inv = 1.0 / d
@@ -214,23 +215,25 @@ class Occluders:
             si, ci = np.nonzero(hit_cl)
             for j0 in range(0, len(si), _PAIR_CHUNK):
                 s = cand[si[j0 : j0 + _PAIR_CHUNK]]
-                c = ci[j0 : j0 + _PAIR_CHUNK]
-                hit = _moller_trumbore(p0[s], d[s], ob["v0"][c], ob["e1"][c], ob["e2"][c], tmin[s], tmax[s])
+                hit = _moller_trumbore(p0[s], d[s], ob["soa"][:, ci[j0 : j0 + _PAIR_CHUNK]], tmin[s], tmax[s])
                 out[s[hit]] = True
         return out
 
 
-def _moller_trumbore(o, d, v0, e1, e2, tmin, tmax) -> np.ndarray:
-    """(P,) whether segment p hits any of its cluster's triangles (P, K, 3)."""
-    pvec = np.cross(d[:, None, :], e2)
-    det = np.einsum("pkc,pkc->pk", e1, pvec)
+def _moller_trumbore(o: np.ndarray, d: np.ndarray, tri: np.ndarray, tmin: np.ndarray, tmax: np.ndarray) -> np.ndarray:
+    """(P,) whether segment p hits any of its cluster's K triangles, given by component (9, P, K)."""
+    ox, oy, oz = (o[:, i, None] for i in range(3))
+    dx, dy, dz = (d[:, i, None] for i in range(3))
+    v0x, v0y, v0z, ax, ay, az, bx, by, bz = tri
+    px, py, pz = dy * bz - dz * by, dz * bx - dx * bz, dx * by - dy * bx
+    det = ax * px + ay * py + az * pz
     ok = np.abs(det) > 1e-20
-    inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
-    tvec = o[:, None, :] - v0
-    u = np.einsum("pkc,pkc->pk", tvec, pvec) * inv
-    qvec = np.cross(tvec, e1)
-    v = np.einsum("pc,pkc->pk", d, qvec) * inv
-    t = np.einsum("pkc,pkc->pk", e2, qvec) * inv
+    inv = 1.0 / np.where(ok, det, 1.0)
+    tx, ty, tz = ox - v0x, oy - v0y, oz - v0z
+    u = (tx * px + ty * py + tz * pz) * inv
+    qx, qy, qz = ty * az - tz * ay, tz * ax - tx * az, tx * ay - ty * ax
+    v = (dx * qx + dy * qy + dz * qz) * inv
+    t = (bx * qx + by * qy + bz * qz) * inv
     hit = ok & (u >= 0.0) & (v >= 0.0) & (u + v <= 1.0) & (t > tmin[:, None]) & (t < tmax[:, None])
     return hit.any(axis=1)
 
