@@ -87,3 +87,17 @@ def uv_to_pixel(u: np.ndarray, v: np.ndarray, width: int, height: int) -> tuple[
     col = np.mod(np.floor(np.asarray(u) * width).astype(np.int64), width)
     row = np.clip(np.floor((1.0 - np.asarray(v)) * height).astype(np.int64), 0, height - 1)
     return row, col
+
+
+def dilate(mask: np.ndarray, radius: int = 1) -> np.ndarray:
+    """(H, W) bool mask grown by `radius` pixels (square): wraps around the u seam, clamps at
+    the poles."""
+    out = np.asarray(mask, dtype=bool).copy()
+    rows = out.copy()
+    for k in range(1, radius + 1):
+        rows[k:] |= out[:-k]
+        rows[:-k] |= out[k:]
+    out = rows.copy()
+    for k in range(1, radius + 1):
+        out |= np.roll(rows, k, axis=1) | np.roll(rows, -k, axis=1)
+    return out

@@ -26,6 +26,12 @@ class Params:
     patch_samples: int = 2  # k*k points average the first-order change over patches near the object
     max_bounces: int = 8  # propagation of the change around the room
     bounce_tolerance: float = 2e-3  # stop when a bounce adds less than this share
+    raster_cell: float = 0.7  # plane raster cell, in panorama pixel footprints where the object was: finer keeps more detail, slower
+    exemplar_margin: float = 1.5  # the raster spans the hole and this many times its extent around it
+    synth_neighbourhood: int = 7  # synthesis window (odd): larger follows larger structures, slower
+    synth_levels: int = 0  # pyramid levels of the synthesis, 0 = from the hole's size
+    synth_generations: int = 2  # synthesis passes per level: more settle seams, slower
+    seed: int = 0  # the synthesis's random seed: the same seed gives the same fill
 
 
 PRESETS = {

@@ -41,11 +41,14 @@ class Reflectance:
     guarded: int  # patches with E ~ 0 whose rho could not be measured
 
 
-def recover_reflectance(b: np.ndarray, e: np.ndarray, visible: np.ndarray, e_floor: float) -> Reflectance:
-    """rho = B / E for visible patches; emitters detected; E below `e_floor` guarded."""
+def recover_reflectance(
+    b: np.ndarray, e: np.ndarray, visible: np.ndarray, e_floor: float, e_test: np.ndarray | None = None
+) -> Reflectance:
+    """rho = B / E for visible patches; emitters detected (B above EMITTER_RHO times `e_test`,
+    the luminance of E, by default that of `e`); E below `e_floor` guarded."""
     by, ey = b @ LUMA, e @ LUMA
     dark = ey <= e_floor
-    emitter = visible & (by > EMITTER_RHO * np.maximum(ey, e_floor))
+    emitter = visible & (by > EMITTER_RHO * np.maximum(ey if e_test is None else e_test, e_floor))
     with np.errstate(invalid="ignore", divide="ignore"):
         rho = np.where(e > e_floor, b / np.where(e > e_floor, e, 1.0), 0.0)
     over = visible & ~emitter & (rho >= RHO_MAX).any(axis=1)

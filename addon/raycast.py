@@ -149,8 +149,8 @@ def _slab(origin: np.ndarray, inv_dir: np.ndarray, lo: np.ndarray, hi: np.ndarra
     with np.errstate(invalid="ignore"):
         t0 = (lo - origin) * inv_dir
         t1 = (hi - origin) * inv_dir
-    t0 = np.nan_to_num(t0, nan=-np.inf)
-    t1 = np.nan_to_num(t1, nan=np.inf)
+    np.nan_to_num(t0, copy=False, nan=-np.inf)
+    np.nan_to_num(t1, copy=False, nan=np.inf)
     near = np.minimum(t0, t1).max(axis=-1)
     far = np.maximum(t0, t1).min(axis=-1)
     return (near <= far) & (far >= tmin) & (near <= tmax)
@@ -178,12 +178,21 @@ class Occluders:
             flat = tris.reshape(n_cl, _CLUSTER * 3, 3)
             # Structure of arrays, (9, n_cl, K): v0, e1, e2 by component, for gathers per cluster.
             soa = np.concatenate([tris[:, 0], tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0]], axis=1)
+            clo, chi = flat.min(axis=1) - eps, flat.max(axis=1) + eps
+            # Groups of _CLUSTER consecutive (Morton-ordered, so nearby) clusters: a third level
+            # keeps a high-poly object from costing every segment a test per cluster.
+            n_gr = -(-n_cl // _CLUSTER)
+            members = np.arange(n_gr * _CLUSTER)
+            members = np.where(members < n_cl, members, -1).reshape(n_gr, _CLUSTER)[:, : min(n_cl, _CLUSTER)]
             self.objects.append(
                 dict(
                     lo=lo_o - eps,
                     hi=hi_o + eps,
-                    clo=flat.min(axis=1) - eps,
-                    chi=flat.max(axis=1) + eps,
+                    glo=np.where(members[..., None] >= 0, clo[members], np.inf).min(axis=1),
+                    ghi=np.where(members[..., None] >= 0, chi[members], -np.inf).max(axis=1),
+                    members=members,
+                    clo=clo,
+                    chi=chi,
                     soa=np.ascontiguousarray(soa.T.reshape(9, n_cl, _CLUSTER)),
                 )
             )
@@ -209,15 +218,32 @@ class Occluders:
             cand = np.flatnonzero(~out & _slab(p0, inv, ob["lo"], ob["hi"], tmin, tmax))
             if len(cand) == 0:
                 continue
-            hit_cl = _slab(
-                p0[cand, None, :], inv[cand, None, :], ob["clo"][None], ob["chi"][None], tmin[cand, None], tmax[cand, None]
-            )
-            si, ci = np.nonzero(hit_cl)
+            si, ci = _descend(p0, inv, tmin, tmax, cand, ob["glo"], ob["ghi"], None)
+            si, ci = _descend(p0, inv, tmin, tmax, si, ob["clo"], ob["chi"], ob["members"][ci])
             for j0 in range(0, len(si), _PAIR_CHUNK):
-                s = cand[si[j0 : j0 + _PAIR_CHUNK]]
+                s = si[j0 : j0 + _PAIR_CHUNK]
                 hit = _moller_trumbore(p0[s], d[s], ob["soa"][:, ci[j0 : j0 + _PAIR_CHUNK]], tmin[s], tmax[s])
                 out[s[hit]] = True
         return out
+
+
+def _descend(p0, inv, tmin, tmax, seg: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+             children: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    """(segment, box) pairs whose boxes the segments `seg` cross, among all boxes (children
+    None) or, per segment, among the box indices children[i] (len(seg), K; -1 for none)."""
+    out_s, out_b = [], []
+    width = len(lo) if children is None else children.shape[1]
+    per = max(1, _PAIR_CHUNK * 4 // max(width, 1))
+    for i0 in range(0, len(seg), per):
+        s = seg[i0 : i0 + per]
+        boxes = np.broadcast_to(np.arange(len(lo)), (len(s), len(lo))) if children is None else children[i0 : i0 + per]
+        hit = _slab(p0[s, None, :], inv[s, None, :], lo[boxes], hi[boxes], tmin[s, None], tmax[s, None]) & (boxes >= 0)
+        r, c = np.nonzero(hit)
+        out_s.append(s[r])
+        out_b.append(boxes[r, c])
+    if not out_s:
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+    return np.concatenate(out_s), np.concatenate(out_b)
 
 
 def _moller_trumbore(o: np.ndarray, d: np.ndarray, tri: np.ndarray, tmin: np.ndarray, tmax: np.ndarray) -> np.ndarray:

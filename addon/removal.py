@@ -20,6 +20,7 @@ import numpy as np
 from . import latlong
 from .errors import Cancelled, DimredError
 from .formfactor import paired_point_to_triangle
+from .hiddenfill import PanoramaMaps, fill_surface
 from .geometry import Geometry, boundary_objects, build_geometry, plane_of_object, surface_keys
 from .patches import Lattice, build_lattice, levels_for_count, levels_for_size, triangle_samples
 from .planner import neighbourhood, shadow_volume
@@ -28,6 +29,7 @@ from .radiosity import LUMA, RHO_MAX, fill_unseen, patch_radiosity, propagate, r
 from .raycast import Occluders, trace_panorama
 from .report import Report
 from .scene import SceneData
+from .synthesis import SynthesisParams
 from .transport import Senders, make_senders, pair_visibility, transport
 
 _MIN_COS = 0.05  # pixels seen more grazing than this count as if at this angle (area weight)
@@ -72,6 +74,8 @@ class _Room:
     emitter: np.ndarray  # (P,) bool
     rho: np.ndarray  # (P, 3)
     areas: np.ndarray  # (P,)
+    receivers: np.ndarray  # (R, 3) coarse receiver points
+    receiver_normals: np.ndarray  # (R, 3)
     t_with: np.ndarray  # (R, P) receiver transport with the object
     t_without: np.ndarray  # (R, P) ... and without it
     patch_rows: np.ndarray  # (P,) receiver row of each patch's centroid
@@ -81,8 +85,11 @@ class _Room:
 
 
 class _Removal:
-    def __init__(self, scene: SceneData, target: int, planes: list[int], params: Params, report: Report, check):
-        self.scene, self.target, self.planes, self.params, self.rep, self.check = scene, target, planes, params, report, check
+    def __init__(self, scene: SceneData, target: int, planes: list[int], params: Params, report: Report,
+                 cancel: Callable[[], bool] | None):
+        self.scene, self.target, self.planes, self.params, self.rep = scene, target, planes, params, report
+        self.cancel = cancel
+        self.check = _cancel_check(cancel)
         self.hdri = scene.hdri
         self.height, self.width = scene.hdri.shape[:2]
 
@@ -99,13 +106,37 @@ class _Removal:
         self.hp = np.flatnonzero(flat_tri >= 0)
         self.tri_h = flat_tri[self.hp]
         self.obj_h = self.geo.tri_object[self.tri_h]
-        self.hidden_h = self.obj_h == self.target
+        # A pixel on the object's silhouette mixes it with what is behind; the ratio form would
+        # scale the object's share of it too, so it is filled like the pixels the object covers.
+        on_object = np.zeros(self.height * self.width, dtype=bool)
+        on_object[self.hp[self.obj_h == self.target]] = True
+        silhouette = latlong.dilate(on_object.reshape(self.height, self.width), 1).ravel()
+        self.hidden_h = silhouette[self.hp]
         self.points_h = hits.points.reshape(-1, 3)[self.hp]
         self.normals_h = self.geo.normals[self.tri_h]
         missing = len(flat_tri) - len(self.hp)
         if missing:
             self.rep.warn(f"{missing} panorama pixels see no proxy geometry (open room?); they are left unchanged")
         self.rep.info["hidden_pixels"] = int(self.hidden_h.sum())
+        self.tri_without = np.full(self.height * self.width, -1, dtype=np.int64)
+        self.distance_without = np.zeros(self.height * self.width)
+        self.revealed = np.zeros(0, dtype=np.int64)
+        if self.hidden_h.any():
+            # What the probe would see where the object was: the surfaces to fill.
+            keep = np.flatnonzero(self.geo.tri_object != self.target)
+            behind = trace_panorama(self.geo.triangles[keep], self.width, self.height)
+            flat = behind.tri.ravel()
+            self.tri_without[flat >= 0] = keep[flat[flat >= 0]]
+            self.distance_without = behind.distance.ravel()
+            hidden = np.flatnonzero(self.hidden_h)
+            self.revealed = hidden[self.tri_without[self.hp[hidden]] >= 0]
+            pix = self.hp[self.revealed]
+            self.rev_tri = self.tri_without[pix]
+            self.rev_bary = behind.bary.reshape(-1, 2)[pix]
+            self.rev_points = behind.points.reshape(-1, 3)[pix]
+            unseen = len(hidden) - len(self.revealed)
+            if unseen:
+                self.rep.warn(f"{unseen} pixels of the object see no proxy geometry behind it; they are left unchanged")
 
     def occluders(self) -> None:
         geo = self.geo
@@ -143,6 +174,7 @@ class _Removal:
         ])
         receiver_normals = np.concatenate([geo.normals[lat.vertex_tri[room_vertex]], pnorm])
         patch_h, corners_h, self.weights_h = lat.locate(self.tri_h, self.hits.bary.reshape(-1, 2)[self.hp])
+        self.vertex_row = vertex_row
         self.corners_h = vertex_row[corners_h]
         self.patch_h = patch_h
         cos = np.abs(np.einsum("ij,ij->i", self.hits.directions.reshape(-1, 3)[self.hp], self.normals_h))
@@ -177,20 +209,23 @@ class _Removal:
         self.check()
         t_with, t_without = transport(receivers, receiver_normals, senders, self.occ_removed, self.occ_others, self.check)
 
-        def mean(v):
-            return v[patch_rows]
-
-        e = mean(t_with @ b)
+        # A light source outshines what it receives at every point; a patch partly under the
+        # object may receive ~0 at its centroid only, so the test takes its brightest receiver.
+        corner_rows = np.where(on_target[:, None], patch_rows[:, None], vertex_row[lat.patch_corners])
+        test_rows = np.concatenate([patch_rows[:, None], corner_rows], axis=1)
+        e_all = t_with @ b
+        e = e_all[patch_rows]
         e_floor = 1e-9 * max(float((e @ LUMA).max()), 1e-30)
         keys = surface_keys(geo)[lat.patch_tri]
         unseen = ~visible
         for _ in range(3):
-            refl = recover_reflectance(b, e, visible, e_floor)
+            refl = recover_reflectance(b, e, visible, e_floor, (e_all @ LUMA)[test_rows].max(axis=1))
             measured = visible & ~refl.emitter & ((e @ LUMA) > e_floor)
             rho = fill_unseen(refl.rho, measured, [keys, geo.tri_object[lat.patch_tri]], areas)
             rho[refl.emitter] = 0.0
             b[unseen] = rho[unseen] * e[unseen]
-            e = mean(t_with @ b)
+            e_all = t_with @ b
+            e = e_all[patch_rows]
         senders.radiosity = b
         self.rep.guard("reflectance_clamped_patches", refl.clamped)
         self.rep.guard("irradiance_near_zero_patches", refl.guarded)
@@ -202,30 +237,85 @@ class _Removal:
             coarse_receivers=int(len(receivers)),
         )
         self.emitter_h = refl.emitter[patch_h]
-        return _Room(lat, senders, important, visible, refl.emitter, rho, areas, t_with, t_without, patch_rows)
+        return _Room(lat, senders, important, visible, refl.emitter, rho, areas, receivers, receiver_normals, t_with,
+                     t_without, patch_rows)
+
+    def _seen(self, points: np.ndarray) -> np.ndarray:
+        """(N,) whether the probe (the origin) sees each point."""
+        probe = np.zeros_like(points)
+        seen = ~self.occ_removed.blocked(probe, points)
+        if self.occ_others is not None:
+            seen &= ~self.occ_others.blocked(probe, points)
+        return seen
+
+    def _transport(self, points: np.ndarray, normals: np.ndarray, senders: Senders) -> tuple[np.ndarray, np.ndarray]:
+        return transport(points, normals, senders, self.occ_removed, self.occ_others, self.check)
+
+    def _sample(self, room: _Room, idx: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """k^2 points on each patch idx (n*k^2, 3), their normals, transport with and without the
+        object, and whether the probe sees them (n, k^2, 1)."""
+        pts = triangle_samples(room.lattice.patch_triangles()[idx], k).reshape(-1, 3)
+        nrm = np.repeat(room.senders.normals[idx], k * k, axis=0)
+        tw, two = self._transport(pts, nrm, room.senders)
+        return pts, nrm, tw, two, self._seen(pts).reshape(len(idx), k * k, 1)
 
     def first_order_patches(self, room: _Room) -> np.ndarray:
-        """(P, 3) first-order change of irradiance, averaged over each patch."""
-        prm, lat = self.params, room.lattice
+        """(P, 3) first-order change of irradiance, averaged over each patch.
+
+        Patches near the object are sampled at k^2 points, and the samples the probe cannot see
+        correct what the pixels alone got wrong for a patch partly under or behind the object:
+        its reflectance is B over the E of the seen samples (B comes from visible pixels, and E
+        ~ 0 under the object), and its radiosity as a sender covers the unseen part too (dark
+        under the object: with B of the lit part there, taking the object away would seem to
+        reveal light that was never there, on top of the light the revealed part really gets)."""
+        prm = self.params
         b = room.senders.radiosity
-        de = room.patch_mean((room.t_without - room.t_with) @ b)
-        ptris = lat.patch_triangles()
+        ptris = room.lattice.patch_triangles()
         centre = ptris.mean(axis=1)
         radius = np.linalg.norm(ptris - centre[:, None, :], axis=2).max(axis=1)
         imp = np.flatnonzero(room.important)
-        on_target = room.senders.on_removed
         e = room.patch_mean(room.t_with @ b)
         near = self._significant(room, imp, centre, e, margin=radius).any(axis=1)
         near |= neighbourhood(centre, self.obj_centre, self.obj_radius + radius, prm.reach)
-        refine = np.flatnonzero(near & ~on_target & ~room.emitter)
-        if len(refine):
-            k = prm.patch_samples
-            pts = triangle_samples(ptris[refine], k).reshape(-1, 3)
-            nrm = np.repeat(room.senders.normals[refine], k * k, axis=0)
-            tw, two = transport(pts, nrm, room.senders, self.occ_removed, self.occ_others, self.check)
-            de[refine] = ((two - tw) @ b).reshape(len(refine), k * k, 3).mean(axis=1)
+        refine = np.flatnonzero(near & ~room.senders.on_removed & ~room.emitter)
         self.rep.info["refined_patches"] = int(len(refine))
+        if not len(refine):
+            return room.patch_mean((room.t_without - room.t_with) @ b)
+        pts, nrm, tw, two, seen = self._sample(room, refine, prm.patch_samples)
+        n, k2 = seen.shape[:2]
+        e_s = (tw @ b).reshape(n, k2, 3)
+        n_seen = seen.sum(axis=1)
+        e_seen = (e_s * seen).sum(axis=1) / np.maximum(n_seen, 1)
+        remeasure = room.visible[refine] & (n_seen[:, 0] > 0) & ((e_seen @ LUMA) > 0.0)
+        idx = refine[remeasure]
+        room.rho[idx] = np.clip(b[idx] / np.maximum(e_seen[remeasure], 1e-30), 0.0, RHO_MAX)
+
+        # A centroid under the object hides the patch from receivers that see most of it.
+        partial = refine[(n_seen[:, 0] < k2) | ~self._seen(centre[refine])]
+        de_partial = None
+        if len(partial):
+            de_partial = self._resample(room, partial, 2 * prm.patch_samples)
+            tw[:, partial], two[:, partial] = self._transport(pts, nrm, room.senders.subset(partial))
+        de = room.patch_mean((room.t_without - room.t_with) @ b)
+        de[refine] = ((two - tw) @ b).reshape(n, k2, 3).mean(axis=1)
+        if de_partial is not None:
+            de[partial] = de_partial
         return de
+
+    def _resample(self, room: _Room, idx: np.ndarray, k: int) -> np.ndarray:
+        """Patches idx as senders sampled at k^2 points weighted by their light, dark where the
+        probe cannot see and the estimate says so; (n, 3) their first-order change of E."""
+        b = room.senders.radiosity
+        pts, nrm, tw, two, seen = self._sample(room, idx, k)
+        e_s = (tw @ b).reshape(len(idx), k * k, 3)
+        b_s = np.where(seen, b[idx, None, :], room.rho[idx, None, :] * e_s)
+        b[idx] = b_s.mean(axis=1)
+        room.senders.resample(idx, pts.reshape(len(idx), k * k, 3), b_s @ LUMA)
+        sub = room.senders.subset(idx)
+        room.t_with[:, idx], room.t_without[:, idx] = self._transport(room.receivers, room.receiver_normals, sub)
+        tw[:, idx], two[:, idx] = self._transport(pts, nrm, sub)
+        self.rep.info["resampled_patches"] = int(len(idx))
+        return ((two - tw) @ b).reshape(len(idx), k * k, 3).mean(axis=1)
 
     def _sender_spheres(self, room: _Room, idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         tris = room.senders.triangles[idx]
@@ -256,9 +346,25 @@ class _Removal:
         bound = b_y[None] * area[None] / (np.pi * d2)
         return sv & (bound >= self.params.significance * np.maximum(e_points @ LUMA, 1e-30)[:, None])
 
+    def _fine_transport(self, room: _Room, tri: np.ndarray, bary: np.ndarray):
+        """Transport with and without the object at the vertices of a fine lattice (cells of
+        about obj_radius / fine_cells) over the triangles `tri`, only the vertices that the
+        points (tri, bary) interpolate from: (T, T', corner rows (N, 3), weights (N, 3))."""
+        geo = self.geo
+        tris_r = np.unique(tri)
+        levels = np.zeros(len(geo.triangles), dtype=np.int64)
+        levels[tris_r] = levels_for_size(geo.triangles[tris_r], self.obj_radius / self.params.fine_cells, max_level=512)
+        fine = build_lattice(geo.triangles, levels)
+        _, corners, weights = fine.locate(tri, bary)
+        needed, inverse = np.unique(corners, return_inverse=True)
+        self.check()
+        tf, tf_w = self._transport(_inset(fine.vertices[needed], geo.triangles[fine.vertex_tri[needed]]),
+                                   geo.normals[fine.vertex_tri[needed]], room.senders)
+        return tf, tf_w, inverse.reshape(corners.shape), weights
+
     def local(self, room: _Room) -> tuple[np.ndarray, np.ndarray]:
         """Per-pixel E and first-order dE; exact where the object's shadow of a light falls."""
-        prm, geo = self.params, self.geo
+        prm = self.params
         b = room.senders.radiosity
         imp = np.flatnonzero(room.important)
         unimp = ~room.important
@@ -286,18 +392,8 @@ class _Removal:
         lattice_e = (self.weights_h[pix] * room.t_with[self.corners_h[pix], s[:, None]]).sum(axis=1)
         ni = ci[near]
         if len(ni):
-            tris_r = np.unique(self.tri_h[ni])
-            levels = np.zeros(len(geo.triangles), dtype=np.int64)
-            levels[tris_r] = levels_for_size(geo.triangles[tris_r], self.obj_radius / prm.fine_cells, max_level=512)
-            fine = build_lattice(geo.triangles, levels)
-            _, corners, weights = fine.locate(self.tri_h[ni], self.hits.bary.reshape(-1, 2)[self.hp[ni]])
-            needed, inverse = np.unique(corners, return_inverse=True)
-            inverse = inverse.reshape(corners.shape)
-            self.check()
-            tf, tf_w = transport(_inset(fine.vertices[needed], geo.triangles[fine.vertex_tri[needed]]),
-                                 geo.normals[fine.vertex_tri[needed]], room.senders,
-                                 self.occ_removed, self.occ_others, self.check)
-            self.rep.info["fine_vertices"] = int(len(needed))
+            tf, tf_w, inverse, weights = self._fine_transport(room, self.tri_h[ni], self.hits.bary.reshape(-1, 2)[self.hp[ni]])
+            self.rep.info["fine_vertices"] = int(len(tf))
             e_pix[ni] = _interp(tf @ b, inverse, weights)
             de_pix[ni] = _interp((tf_w - tf)[:, unimp] @ b[unimp], inverse, weights)
             row = np.full(len(self.hp), -1)
@@ -313,6 +409,70 @@ class _Removal:
         np.add.at(de_pix, pix, (f * (vis_w - vis))[:, None] * b[s])
         self.rep.info["exact_pairs"] = int(len(s))
         return e_pix, de_pix
+
+    def fill_hidden(self, room: _Room, e_pix: np.ndarray, de_prop_v: np.ndarray) -> np.ndarray:
+        """(N, 3) radiance change of the revealed pixels (those that saw the object and see a
+        surface once it is gone): synthesised reflectance lit by the irradiance after removal."""
+        geo, prm = self.geo, self.params
+        b = room.senders.radiosity
+        if not len(self.revealed):
+            return np.zeros((0, 3))
+        tri, bary, points = self.rev_tri, self.rev_bary, self.rev_points
+        _, tf_w, inverse, weights = self._fine_transport(room, tri, bary)
+        patch, corners, w_coarse = room.lattice.locate(tri, bary)
+        e_new = _interp(tf_w @ b, inverse, weights) + _interp(de_prop_v, self.vertex_row[corners], w_coarse)
+        e_new = np.maximum(e_new, 0.0)
+
+        keys = surface_keys(geo)
+        n = self.height * self.width
+        surface_with = np.full(n, -1, dtype=np.int64)
+        surface_with[self.hp] = keys[self.tri_h]
+        has = self.tri_without >= 0
+        surface_without = np.where(has, keys[np.maximum(self.tri_without, 0)], -1)
+        hidden_map = np.zeros(n, dtype=bool)
+        hidden_map[self.hp[self.hidden_h]] = True
+        shape = (self.height, self.width)
+        maps = PanoramaMaps(surface_with.reshape(shape), self.hits.distance, surface_without.reshape(shape),
+                            self.distance_without.reshape(shape), hidden_map.reshape(shape))
+        radiance = self.hdri.reshape(-1, 3)[self.hp].astype(np.float64)
+        e_ref = float(np.median(e_pix @ LUMA))
+        measured = ~self.hidden_h & ~self.emitter_h & ((e_pix @ LUMA) > 1e-3 * e_ref)
+        rho_flat = np.zeros((n, 3))
+        rho_flat[self.hp[measured]] = np.clip(np.pi * radiance[measured] / e_pix[measured], 0.0, RHO_MAX)
+        valid = np.zeros(n, dtype=bool)
+        valid[self.hp[measured]] = True
+        rho_image, valid = rho_flat.reshape(*shape, 3), valid.reshape(shape)
+
+        # Raster cells about as large as the panorama's pixels where the object was.
+        pix = self.hp[self.revealed]
+        solid = np.broadcast_to(latlong.pixel_solid_angles(self.width, self.height), shape).ravel()[pix]
+        cos = np.abs(np.einsum("ij,ij->i", self.hits.directions.reshape(-1, 3)[pix], geo.normals[tri]))
+        footprint = np.sqrt(solid * self.distance_without[pix] ** 2 / np.maximum(cos, _MIN_COS))
+        cell = float(np.median(footprint)) * prm.raster_cell
+        synth = SynthesisParams(neighbourhood=prm.synth_neighbourhood, levels=prm.synth_levels,
+                                generations=prm.synth_generations)
+        rho = room.rho[patch].copy()
+        surfaces = []
+        for key in np.unique(keys[tri]):
+            sel = np.flatnonzero(keys[tri] == key)
+            self.check()
+            got = fill_surface(maps, rho_image, valid, int(key), geo.normals[tri[sel[0]]], points[sel], cell,
+                               prm.exemplar_margin, synth, seed=prm.seed, cancel=self.cancel)
+            name = geo.object_names[geo.tri_object[tri[sel[0]]]]
+            if got.known_cells:
+                rho[sel] = got.rho
+            if not got.synthesised:
+                self.rep.warn(f"too little of '{name}' is seen around the object to synthesise its texture: "
+                              f"{len(sel)} pixels get its mean reflectance")
+            surfaces.append(dict(surface=name, pixels=int(len(sel)), raster=list(got.raster_shape),
+                                 cell=round(got.cell, 5), known_cells=got.known_cells,
+                                 hole_cells=got.hole_cells, synthesised=got.synthesised))
+        self.rep.info["filled_surfaces"] = surfaces
+        new = rho * e_new / np.pi
+        # A light behind the object shines on with the radiosity its patch was given.
+        emit = room.emitter[patch]
+        new[emit] = b[patch[emit]] / np.pi
+        return new - radiance[self.revealed]
 
     def compose(self, e_pix: np.ndarray, de_pix: np.ndarray) -> np.ndarray:
         """(N, 3) radiance change of the hit pixels from the ratio form, with guards counted."""
@@ -344,7 +504,7 @@ def remove(
 ) -> RemovalResult:
     """Remove `object_name`'s shadows and reflected light from the scene's panorama."""
     params = params or Params()
-    rep = Report(progress, stages=7)
+    rep = Report(progress, stages=8)
     check = _cancel_check(cancel)
     if object_name not in scene.object_names:
         raise DimredError(f"no mesh object named '{object_name}' among the scene's proxy geometry")
@@ -362,7 +522,7 @@ def remove(
                 raise DimredError(f"'{name}' is not planar: --plane takes flat surfaces only")
             plane_ids.append(idx)
         rep.guard("degenerate_triangles_dropped", geo.dropped_degenerate)
-    job = _Removal(scene, target, plane_ids, params, rep, check)
+    job = _Removal(scene, target, plane_ids, params, rep, cancel)
     job.geometry(geo)
     with rep.stage("trace"):
         job.trace()
@@ -379,9 +539,17 @@ def remove(
     check()
     with rep.stage("local"):
         e_pix, de_pix = job.local(room)
+    if len(job.revealed):
+        with rep.stage("synthesis"):
+            d_revealed = job.fill_hidden(room, e_pix, de_prop_v)
+    else:
+        d_revealed = np.zeros((0, 3))
+        rep.skip("synthesis", "the object is not visible from the probe centre: no hidden region to fill"
+                 if not job.hidden_h.any() else "nothing is behind the object to fill")
     with rep.stage("compose"):
         de_pix = de_pix + _interp(de_prop_v, job.corners_h, job.weights_h)
         d = job.compose(e_pix, de_pix)
+        d[job.revealed] = d_revealed
         h, w = job.height, job.width
         difference = np.zeros((h * w, 3), dtype=np.float32)
         difference[job.hp] = d
@@ -390,10 +558,5 @@ def remove(
         hidden[job.hp[job.hidden_h]] = True
         hidden = hidden.reshape(h, w)
         edited = (scene.hdri + difference).astype(np.float32)
-    if not hidden.any():
-        rep.skip("synthesis", "the object is not visible from the probe centre: no hidden region to fill")
-    else:
-        rep.skip("synthesis", "texture synthesis of the hidden region is not available yet")
-        rep.warn(f"the hidden region ({int(hidden.sum())} pixels where the object was seen) was not filled")
-    rep.info["hidden_region_filled"] = False
+    rep.info["hidden_region_filled"] = bool(len(job.revealed) == job.hidden_h.sum())
     return RemovalResult(difference=difference, edited=edited, hidden_mask=hidden, report=rep.as_dict())

@@ -27,7 +27,9 @@ class Senders:
     """Sender patches: triangles, normals, and the visibility sample points of each.
 
     Senders are sampled at `len(samples[g])` points each, one count per group g, so the
-    important ones can be sampled densely and the rest at their centroid.
+    important ones can be sampled densely and the rest at their centroid. A sample's weight is
+    its share of the patch's light (uniform unless the radiosity varies over the patch, as on a
+    patch half under the removed object), and the visible fraction is weighted by it.
     """
 
     triangles: np.ndarray  # (S, 3, 3)
@@ -37,9 +39,24 @@ class Senders:
     group: np.ndarray  # (S,) which sample group
     slot: np.ndarray  # (S,) row in that group's samples
     samples: list[np.ndarray]  # per group: (n_g, m_g, 3)
+    weights: list[np.ndarray]  # per group: (n_g, m_g), each row summing to 1
 
     def __len__(self) -> int:
         return len(self.triangles)
+
+    def resample(self, idx: np.ndarray, samples: np.ndarray, weights: np.ndarray) -> None:
+        """Give senders `idx` new sample points (n, m, 3) with light weights (n, m) >= 0."""
+        total = weights.sum(axis=1, keepdims=True)
+        weights = np.where(total > 0.0, weights / np.where(total > 0.0, total, 1.0), 1.0 / weights.shape[1])
+        self.group[idx] = len(self.samples)
+        self.slot[idx] = np.arange(len(idx))
+        self.samples.append(samples)
+        self.weights.append(weights)
+
+    def subset(self, idx: np.ndarray) -> "Senders":
+        """The senders `idx` alone (sharing the sample groups)."""
+        return Senders(self.triangles[idx], self.normals[idx], self.radiosity[idx], self.on_removed[idx],
+                       self.group[idx], self.slot[idx], self.samples, self.weights)
 
 
 def make_senders(triangles, normals, radiosity, on_removed, sample_sets: list[tuple[np.ndarray, np.ndarray]]) -> Senders:
@@ -49,7 +66,8 @@ def make_senders(triangles, normals, radiosity, on_removed, sample_sets: list[tu
     for g, (idx, _) in enumerate(sample_sets):
         group[idx] = g
         slot[idx] = np.arange(len(idx))
-    return Senders(triangles, normals, radiosity, on_removed, group, slot, [smp for _, smp in sample_sets])
+    return Senders(triangles, normals, radiosity, on_removed, group, slot, [smp for _, smp in sample_sets],
+                   [np.full(smp.shape[:2], 1.0 / smp.shape[1]) for _, smp in sample_sets])
 
 
 def pair_visibility(
@@ -59,8 +77,10 @@ def pair_visibility(
     """Visible fractions of sender s[i] from point r[i]: with the removed object, and without it."""
     vis = np.zeros(len(r))
     vis_without = np.zeros(len(r))
-    for g, samples in enumerate(senders.samples):
+    for g, (samples, weights) in enumerate(zip(senders.samples, senders.weights)):
         sel = np.flatnonzero(senders.group[s] == g)
+        if not len(sel):
+            continue
         m = samples.shape[1]
         per = max(1, _SEGMENTS_PER_CHUNK // m)
         for i0 in range(0, len(sel), per):
@@ -71,8 +91,9 @@ def pair_visibility(
             p1 = samples[senders.slot[s[k]]].reshape(-1, 3)
             b_o = removed.blocked(p0, p1) if removed is not None else np.zeros(len(p0), dtype=bool)
             b_x = others.blocked(p0, p1) if others is not None else np.zeros(len(p0), dtype=bool)
-            vis[k] = (~(b_o | b_x)).reshape(-1, m).mean(axis=1)
-            vis_without[k] = (~b_x).reshape(-1, m).mean(axis=1)
+            w = weights[senders.slot[s[k]]]
+            vis[k] = ((~(b_o | b_x)).reshape(-1, m) * w).sum(axis=1)
+            vis_without[k] = ((~b_x).reshape(-1, m) * w).sum(axis=1)
     vis_without = np.where(senders.on_removed[s], 0.0, vis_without)
     return vis, vis_without
 

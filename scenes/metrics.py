@@ -170,3 +170,26 @@ def summary(input: np.ndarray, edit: np.ndarray, truth: np.ndarray,
         "bleeding_input": bleed_in,
         "bleeding_edit": bleed_edit,
     }
+
+
+def hidden_region_scores(input: np.ndarray, edit: np.ndarray, truth: np.ndarray,
+                         object_mask: np.ndarray) -> dict[str, float]:
+    """How well the region the object hid was filled (issue 3's figures):
+
+    - `mean_ratio`: mean Y_edit / mean Y_truth over the object's pixels (1 = same brightness);
+    - `detail_ratio`: standard deviation of the high-pass Y - box_blur3(Y) over those pixels,
+      edit / truth (1 = as much texture; a flat fill gives ~0, noise explosions > 1);
+    - `object_shadow_ratio`: the blurred-Y error sum over the object's pixels and region A
+      together, edit / input (how much of the removal's whole error is left)."""
+    y_in, y_ed, y_tr = luminance(input), luminance(edit), luminance(truth)
+
+    def high_pass(y: np.ndarray) -> np.ndarray:
+        return (y - box_blur3(y))[object_mask]
+
+    region = lighting_region(input, truth, object_mask) | object_mask
+    bi, be, bt = box_blur3(y_in), box_blur3(y_ed), box_blur3(y_tr)
+    return {
+        "mean_ratio": float(y_ed[object_mask].mean() / y_tr[object_mask].mean()),
+        "detail_ratio": float(high_pass(y_ed).std() / max(high_pass(y_tr).std(), 1e-30)),
+        "object_shadow_ratio": float(np.abs(be - bt)[region].sum() / np.abs(bi - bt)[region].sum()),
+    }

@@ -1,0 +1,181 @@
+"""Seconds and quality of hole filling: our synthesis (accelerated and exhaustive) and the 2D fills
+people use today, on procedural floor textures with a square hole in the middle.
+
+Prints a markdown table per case and a summary per method and hole size. Quality against the
+known truth inside the hole: MAE (mean absolute error; low only where the fill can be predicted,
+as for tile lines or a gradient, never for noise), detail (high-pass std, result / truth: 1 is
+right, below is blur) and seam (mean gradient magnitude on the 2 px either side of the hole's
+border, result / truth: above 1 is a visible seam, below is a flattened border).
+
+The outside baselines are optional, benchmark-only dependencies (pins in
+benchmarks/requirements-synthesis.txt; install them into a separate venv, e.g.
+`python -m venv .venv-bench && .venv-bench/bin/pip install -r benchmarks/requirements-synthesis.txt`);
+each one that does not import is listed as not installed. OpenCV, PatchMatch and Resynthesizer
+work on 8-bit images, so their fills carry up to 1/510 of rounding. The exhaustive search is run
+for holes up to --exhaustive-max pixels only (it takes minutes above).
+
+The advantage that matters most for the add-on, filling reflectance so that shadow gradients do
+not leak into the fill, is not measured here: these textures carry no lighting (that is for the
+removal benchmark).
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from addon.synthesis import SynthesisParams, fill  # noqa: E402
+from textures import TEXTURES  # noqa: E402
+
+Method = Callable[[np.ndarray, np.ndarray], np.ndarray]  # (image, hole) -> filled image
+
+
+def ours(search: str) -> Method:
+    return lambda img, hole: fill(img, ~hole, hole, SynthesisParams(search=search))
+
+
+def _u8(img: np.ndarray) -> np.ndarray:
+    return (np.clip(img, 0, 1) * 255 + 0.5).astype(np.uint8)
+
+
+def telea() -> Method:
+    import cv2
+
+    return lambda img, hole: cv2.inpaint(_u8(img), hole.astype(np.uint8) * 255, 3, cv2.INPAINT_TELEA) / 255.0
+
+
+def biharmonic() -> Method:
+    from skimage.restoration import inpaint_biharmonic
+
+    return lambda img, hole: inpaint_biharmonic(img, hole, channel_axis=-1)
+
+
+def patchmatch() -> Method:
+    import patchmatch as pm
+
+    if not pm.patchmatch_available:
+        raise ImportError("the PatchMatch native library did not load")
+
+    def run(img, hole):
+        pm.set_random_seed(0)
+        # patch radius 3 (7 x 7 patches), as in its examples: its default 15 takes ~8 s per 128 px hole
+        return pm.inpaint(_u8(img), hole.astype(np.uint8) * 255, patch_size=3) / 255.0
+
+    return run
+
+
+def resynthesizer() -> Method:
+    from PIL import Image
+    import resynthesizer as rs
+
+    def run(img, hole):
+        params = rs.getDefaultParams()
+        params.isMakeSeamlesslyTileableHorizontally = params.isMakeSeamlesslyTileableVertically = 0  # heal
+        out = rs.resynthesize(Image.fromarray(_u8(img)), Image.fromarray(hole.astype(np.uint8) * 255), params)
+        return np.asarray(out) / 255.0
+
+    return run
+
+
+def blur(img: np.ndarray, sigma: float = 2.0) -> np.ndarray:
+    """Separable Gaussian blur of the first two axes, mirrored at the border."""
+    r = int(3 * sigma)
+    k = np.exp(-0.5 * (np.arange(-r, r + 1) / sigma) ** 2)
+    k /= k.sum()
+    for axis in (0, 1):
+        p = np.moveaxis(np.pad(img, [(r, r) if a == axis else (0, 0) for a in range(img.ndim)], mode="reflect"),
+                        axis, 0)
+        img = np.moveaxis(sum(w * p[i:i + img.shape[axis]] for i, w in enumerate(k)), 0, axis)
+    return img
+
+
+def gradient_magnitude(img: np.ndarray) -> np.ndarray:
+    gy, gx = np.zeros(img.shape[:2]), np.zeros(img.shape[:2])
+    gy[1:-1] = np.linalg.norm(img[2:] - img[:-2], axis=-1) / 2
+    gx[:, 1:-1] = np.linalg.norm(img[:, 2:] - img[:, :-2], axis=-1) / 2
+    return np.hypot(gy, gx)
+
+
+def border_ring(hole: np.ndarray, width: int = 2) -> np.ndarray:
+    """Pixels within `width` of the hole's border, inside and outside."""
+    p = np.pad(hole, width)
+    shifts = [p[width + dy:width + dy + hole.shape[0], width + dx:width + dx + hole.shape[1]]
+              for dy in range(-width, width + 1) for dx in range(-width, width + 1)]
+    return np.any(shifts, axis=0) & ~np.all(shifts, axis=0)
+
+
+def quality(out: np.ndarray, truth: np.ndarray, hole: np.ndarray) -> tuple[float, float, float]:
+    mae = float(np.abs(out - truth)[hole].mean())
+    detail = float((out - blur(out))[hole].std() / (truth - blur(truth))[hole].std())
+    ring = border_ring(hole)
+    seam = float(gradient_magnitude(out)[ring].mean() / gradient_magnitude(truth)[ring].mean())
+    return mae, detail, seam
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--sizes", default="32,64,128,256", help="hole sides in pixels, comma separated")
+    ap.add_argument("--textures", default=",".join(TEXTURES))
+    ap.add_argument("--image", type=int, default=512, help="side of the square test images")
+    ap.add_argument("--exhaustive-max", type=int, default=64, help="largest hole the exhaustive search runs on")
+    ap.add_argument("--quick", action="store_true", help="holes 64 and 128 only, no exhaustive search")
+    args = ap.parse_args()
+    sizes = [64, 128] if args.quick else [int(s) for s in args.sizes.split(",")]
+    exhaustive_max = 0 if args.quick else args.exhaustive_max
+
+    methods: dict[str, Method | str] = {"ours accelerated": ours("accelerated"), "ours exhaustive": ours("exhaustive")}
+    for name, make in (("OpenCV Telea", telea), ("skimage biharmonic", biharmonic), ("PatchMatch", patchmatch),
+                       ("Resynthesizer", resynthesizer)):
+        try:
+            methods[name] = make()
+        except (ImportError, OSError) as e:
+            methods[name] = f"not installed ({e.__class__.__name__})"
+
+    print(f"{args.image}x{args.image} images, square hole in the middle; default parameters {SynthesisParams()}")
+    print()
+    print("| texture | hole | method | s | MAE | detail | seam |")
+    print("|---|---|---|---|---|---|---|")
+    rows = []
+    for texture in args.textures.split(","):
+        truth = TEXTURES[texture](args.image)
+        for size in sizes:
+            hole = np.zeros(truth.shape[:2], bool)
+            lo = (args.image - size) // 2
+            hole[lo:lo + size, lo:lo + size] = True
+            img = np.where(hole[..., None], 0, truth).astype(np.float32)  # the hole's truth is never seen
+            for name, method in methods.items():
+                if isinstance(method, str) or (name == "ours exhaustive" and size > exhaustive_max):
+                    why = method if isinstance(method, str) else (
+                        "skipped (--quick)" if args.quick else f"skipped (holes <= {exhaustive_max} px only)")
+                    print(f"| {texture} | {size} | {name} | {why} | | | |", flush=True)
+                    continue
+                t0 = time.perf_counter()
+                out = method(img, hole)
+                seconds = time.perf_counter() - t0
+                mae, detail, seam = quality(out, truth, hole)
+                rows.append((name, size, seconds, mae, detail, seam))
+                print(f"| {texture} | {size} | {name} | {seconds:.2f} | {mae:.4f} | {detail:.2f} | {seam:.2f} |",
+                      flush=True)
+
+    print()
+    print("Mean over the textures:")
+    print()
+    print("| method | hole | s | MAE | detail | seam |")
+    print("|---|---|---|---|---|---|")
+    for name in dict.fromkeys(r[0] for r in rows):
+        for size in sizes:
+            sel = np.array([r[2:] for r in rows if r[0] == name and r[1] == size])
+            if len(sel):
+                s, mae, detail, seam = sel.mean(axis=0)
+                print(f"| {name} | {size} | {s:.2f} | {mae:.4f} | {detail:.2f} | {seam:.2f} |")
+
+
+if __name__ == "__main__":
+    main()
