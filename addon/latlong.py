@@ -89,12 +89,13 @@ def uv_to_pixel(u: np.ndarray, v: np.ndarray, width: int, height: int) -> tuple[
     return row, col
 
 
+
 def dilate(mask: np.ndarray, radius: int = 1) -> np.ndarray:
     """(H, W) bool mask grown by `radius` pixels (square): wraps around the u seam, clamps at
     the poles."""
-    out = np.asarray(mask, dtype=bool).copy()
+    out = np.asarray(mask, dtype=bool)
     rows = out.copy()
-    for k in range(1, radius + 1):
+    for k in range(1, min(radius, out.shape[0] - 1) + 1):
         rows[k:] |= out[:-k]
         rows[:-k] |= out[k:]
     out = rows.copy()

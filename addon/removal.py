@@ -240,11 +240,12 @@ class _Removal:
         return _Room(lat, senders, important, visible, refl.emitter, rho, areas, receivers, receiver_normals, t_with,
                      t_without, patch_rows)
 
-    def _seen(self, points: np.ndarray) -> np.ndarray:
-        """(N,) whether the probe (the origin) sees each point."""
+    def _seen(self, points: np.ndarray, others: bool = True) -> np.ndarray:
+        """(N,) whether the probe (the origin) sees each point (past the removed object only,
+        unless `others`)."""
         probe = np.zeros_like(points)
         seen = ~self.occ_removed.blocked(probe, points)
-        if self.occ_others is not None:
+        if others and self.occ_others is not None:
             seen &= ~self.occ_others.blocked(probe, points)
         return seen
 
@@ -290,8 +291,10 @@ class _Removal:
         idx = refine[remeasure]
         room.rho[idx] = np.clip(b[idx] / np.maximum(e_seen[remeasure], 1e-30), 0.0, RHO_MAX)
 
-        # A centroid under the object hides the patch from receivers that see most of it.
-        partial = refine[(n_seen[:, 0] < k2) | ~self._seen(centre[refine])]
+        # Only the object's cover differs between T and T'; a centroid under the object hides
+        # the patch from receivers that see most of it.
+        under = ~self._seen(pts, others=False).reshape(n, k2).all(axis=1) | ~self._seen(centre[refine], others=False)
+        partial = refine[under]
         de_partial = None
         if len(partial):
             de_partial = self._resample(room, partial, 2 * prm.patch_samples)

@@ -1,6 +1,7 @@
 """Run time of a removal per stage and quality preset, on a rendered 1024x512 scene.
 
-Prints a table (seconds per stage, and the lighting error ratio against the Cycles truth).
+Prints a table: seconds per stage, the lighting error ratio against the Cycles truth, and the
+hidden region's scores (`scenes.metrics.hidden_region_scores`).
 The scene is the `basic_box` spec (a 0.5 m box) rendered at 1024x512; the render is cached
 under .cache/groundtruth, so only the first run pays for Cycles. Timings on a shared machine
 are noisy: compare presets within one run.
@@ -48,14 +49,15 @@ def main() -> None:
     for preset in args.presets.split(","):
         r = remove_object(scene, spec.remove, quality=preset)
         ratio = M.lighting_error_ratio(inp, r.edited, truth, mask)
-        rows.append((preset, r.report["seconds"], ratio))
+        rows.append((preset, r.report["seconds"], ratio, M.hidden_region_scores(inp, r.edited, truth, mask)))
     stages = [k for k in rows[0][1] if k != "total"]
     print(f"scene {args.scene} {args.width}x{args.width // 2} @ {args.samples} spp; read_scene {read_s:.2f} s;"
           f" noise floor {floor:.3f}")
-    print("| preset | " + " | ".join(stages) + " | total s | error ratio |")
-    print("|---" * (len(stages) + 3) + "|")
-    for preset, sec, ratio in rows:
-        print(f"| {preset} | " + " | ".join(f"{sec[k]:.2f}" for k in stages) + f" | {sec['total']:.2f} | {ratio:.3f} |")
+    print("| preset | " + " | ".join(stages) + " | total s | error ratio | hidden mean | hidden detail | object + shadow |")
+    print("|---" * (len(stages) + 6) + "|")
+    for preset, sec, ratio, hidden in rows:
+        print(f"| {preset} | " + " | ".join(f"{sec[k]:.2f}" for k in stages) + f" | {sec['total']:.2f} | {ratio:.3f}"
+              f" | {hidden['mean_ratio']:.3f} | {hidden['detail_ratio']:.2f} | {hidden['object_shadow_ratio']:.3f} |")
 
 
 if __name__ == "__main__":

@@ -23,6 +23,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from addon.latlong import dilate  # noqa: F401  (part of this module's interface)
+
 _LUMA = np.array([0.2126, 0.7152, 0.0722])
 
 
@@ -37,20 +39,6 @@ def box_blur3(a: np.ndarray) -> np.ndarray:
     v = np.concatenate([a[:1], a, a[-1:]], axis=0)
     v = (v[:-2] + v[1:-1] + v[2:]) / 3.0
     return (np.roll(v, 1, axis=1) + v + np.roll(v, -1, axis=1)) / 3.0
-
-
-def dilate(mask: np.ndarray, radius: int) -> np.ndarray:
-    """Square dilation by `radius` px: wraps around the u seam, clamps at the poles."""
-    out = np.asarray(mask, dtype=bool)
-    h = out.shape[0]
-    rows = out.copy()
-    for k in range(1, min(radius, h - 1) + 1):
-        rows[k:] |= out[:-k]
-        rows[:-k] |= out[k:]
-    out = rows.copy()
-    for k in range(1, radius + 1):
-        out |= np.roll(rows, k, axis=1) | np.roll(rows, -k, axis=1)
-    return out
 
 
 def _blurred_y(rgb: np.ndarray) -> np.ndarray:

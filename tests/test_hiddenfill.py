@@ -4,7 +4,7 @@ import numpy as np
 from addon import hiddenfill as HF
 from addon import latlong
 from addon.synthesis import SynthesisParams
-from tests.test_planeraster import FLOOR_Z, maps
+from tests.test_planeraster import maps
 
 WIDTH = 512
 

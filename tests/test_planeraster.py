@@ -53,26 +53,27 @@ def test_raster_covers_the_hole_with_its_margin_and_respects_the_cell_budget():
     assert small.shape[0] * small.shape[1] <= 101 * 101 and small.cell > 0.001
 
 
+def classified_floor(corner_lo, corner_hi, margin, surface=0):
+    """A floor raster around the square between two corners, and its flags."""
+    pts = np.array([[corner_lo, corner_lo, FLOOR_Z], [corner_hi, corner_hi, FLOOR_Z]])
+    r = PR.build_raster(np.array([0, 0, 1.0]), pts, cell=0.02, margin=margin, max_cells=10**6)
+    return r, PR.classify(r, *maps(), surface=surface, tolerance=0.02)
+
+
 def test_classify_finds_the_floor_the_lid_hides():
-    s_with, d_with, s_without, d_without, hidden = maps()
-    pts = np.array([[0.8, 0.8, FLOOR_Z], [1.2, 1.2, FLOOR_Z]])
-    r = PR.build_raster(np.array([0, 0, 1.0]), pts, cell=0.02, margin=1.0, max_cells=10**6)
-    flags = PR.classify(r, s_with, d_with, s_without, d_without, hidden, surface=0, tolerance=0.02)
+    r, flags = classified_floor(0.8, 1.2, margin=1.0)
     p = r.points()
     inside = (np.abs(p[..., 0] - 1.0) < 0.15) & (np.abs(p[..., 1] - 1.0) < 0.15)
     outside = (np.abs(p[..., 0] - 1.0) > 0.27) | (np.abs(p[..., 1] - 1.0) > 0.27)
     assert (flags[inside] == PR.HIDDEN).all()
     assert (flags[outside] == PR.SEEN).all()
     # Seen from the wall's side, no floor cell is on the wall.
-    wall = PR.classify(r, s_with, d_with, s_without, d_without, hidden, surface=1, tolerance=0.02)
+    _, wall = classified_floor(0.8, 1.2, margin=1.0, surface=1)
     assert (wall == PR.OTHER).all()
 
 
 def test_cells_beyond_the_surface_are_other():
-    s_with, d_with, s_without, d_without, hidden = maps()
-    pts = np.array([[2.6, 2.6, FLOOR_Z], [2.9, 2.9, FLOOR_Z]])
-    r = PR.build_raster(np.array([0, 0, 1.0]), pts, cell=0.02, margin=2.0, max_cells=10**6)
-    flags = PR.classify(r, s_with, d_with, s_without, d_without, hidden, surface=0, tolerance=0.02)
+    r, flags = classified_floor(2.6, 2.9, margin=2.0)
     p = r.points()
     beyond = (p[..., 0] > 3.0) | (p[..., 1] > 3.0)
     far_beyond = (p[..., 0] > 3.4) | (p[..., 1] > 3.4)
