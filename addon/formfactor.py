@@ -37,31 +37,25 @@ def _clip_and_integrate(rel: np.ndarray, n: np.ndarray, eps: float) -> np.ndarra
     # edge k if the edge crosses); empty slots repeat a valid neighbour so they add nothing.
     slots = np.stack([rel, cut], axis=2).reshape(len(rel), 6, 3)
     valid = np.stack([inside, crossing], axis=2).reshape(len(rel), 6)
-    any_valid = valid.any(axis=1)
-    fill = _forward_fill(valid)
-    slots = np.take_along_axis(slots, fill[..., None], axis=1)
-    a = slots
-    b = np.roll(slots, -1, axis=1)
-    cr = np.cross(a, b)
-    crn = np.linalg.norm(cr, axis=-1)
-    dot = np.einsum("pkc,pkc->pk", a, b)
-    angle = np.arctan2(crn, dot)
-    proj = np.einsum("pkc,pc->pk", cr, n)
-    contrib = np.where(crn > 1e-300, angle * proj / np.where(crn > 1e-300, crn, 1.0), 0.0)
-    f = np.abs(contrib.sum(axis=1)) / (2.0 * np.pi)
-    return np.where(any_valid, f, 0.0)
+    slots = np.take_along_axis(slots, _forward_fill(valid)[..., None], axis=1)
+    return np.where(valid.any(axis=1), _contour(slots, n), 0.0)
 
 
-def _whole_triangle(rel: np.ndarray, n: np.ndarray) -> np.ndarray:
-    """Lambert's formula for triangles (P, 3, 3) wholly above the tangent plane: no clipping."""
-    a = rel / np.linalg.norm(rel, axis=-1, keepdims=True)
-    b = a[:, [1, 2, 0]]
+def _contour(polygon: np.ndarray, n: np.ndarray) -> np.ndarray:
+    """Lambert's formula for polygons (P, K, 3) wholly above the tangent plane (vertices relative
+    to the receiver, any length: the edge angle and the projected direction are scale-free)."""
+    a, b = polygon, np.roll(polygon, -1, axis=1)
     cr = np.cross(a, b)
     crn = np.linalg.norm(cr, axis=-1)
     angle = np.arctan2(crn, np.einsum("pkc,pkc->pk", a, b))
     proj = np.einsum("pkc,pc->pk", cr, n)
     contrib = np.where(crn > 1e-300, angle * proj / np.where(crn > 1e-300, crn, 1.0), 0.0)
     return np.abs(contrib.sum(axis=1)) / (2.0 * np.pi)
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    """Rows scaled to length 1: a whole triangle's contour is integrated on the unit sphere."""
+    return v / np.linalg.norm(v, axis=-1, keepdims=True)
 
 
 def _pairs(rel: np.ndarray, n: np.ndarray, sender_normals: np.ndarray | None, eps: float) -> np.ndarray:
@@ -74,7 +68,7 @@ def _pairs(rel: np.ndarray, n: np.ndarray, sender_normals: np.ndarray | None, ep
     whole = some & above.all(axis=1)
     part = some & ~whole
     f = np.zeros(len(rel))
-    f[whole] = _whole_triangle(rel[whole], n[whole])
+    f[whole] = _contour(_unit(rel[whole]), n[whole])
     if part.any():
         f[part] = _clip_and_integrate(rel[part], n[part], eps)
     return f

@@ -65,12 +65,12 @@ def fill_surface(
     values, weight = PR.sample_panorama(raster, rho_image, rho_valid & (maps.surface_with == surface))
     known = (flags == PR.SEEN) & (weight > 0.5)
     # The hidden points are looked up bilinearly: fill the cells around each as well.
-    r, c = raster.coords(points)
+    r, c = (np.floor(x).astype(np.int64) for x in raster.coords(points))
     hole = np.zeros(raster.shape, dtype=bool)
     h, w = raster.shape
     for dr in (0, 1):
         for dc in (0, 1):
-            hole[np.clip(np.floor(r).astype(np.int64) + dr, 0, h - 1), np.clip(np.floor(c).astype(np.int64) + dc, 0, w - 1)] = True
+            hole[np.clip(r + dr, 0, h - 1), np.clip(c + dc, 0, w - 1)] = True
     hole |= flags == PR.HIDDEN
     hole &= ~known
     mean = values[known].mean(axis=0) if known.any() else np.zeros(3)

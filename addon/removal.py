@@ -20,8 +20,8 @@ import numpy as np
 from . import latlong
 from .errors import Cancelled, DimredError
 from .formfactor import paired_point_to_triangle
-from .hiddenfill import PanoramaMaps, fill_surface
 from .geometry import Geometry, boundary_objects, build_geometry, plane_of_object, surface_keys
+from .hiddenfill import PanoramaMaps, fill_surface
 from .patches import Lattice, build_lattice, levels_for_count, levels_for_size, triangle_samples
 from .planner import neighbourhood, shadow_volume
 from .quality import Params
@@ -96,6 +96,7 @@ class _Removal:
     # -- stages ---------------------------------------------------------------------------
     def geometry(self, geo: Geometry) -> None:
         self.geo = geo
+        self.surface_key = surface_keys(geo)
         self.eps = 1e-6 * geo.scale
         self.obj_centre, self.obj_radius = geo.bounding_sphere(self.target)
 
@@ -112,6 +113,9 @@ class _Removal:
         on_object[self.hp[self.obj_h == self.target]] = True
         silhouette = latlong.dilate(on_object.reshape(self.height, self.width), 1).ravel()
         self.hidden_h = silhouette[self.hp]
+        hidden_map = np.zeros(self.height * self.width, dtype=bool)
+        hidden_map[self.hp[self.hidden_h]] = True
+        self.hidden_map = hidden_map.reshape(self.height, self.width)
         self.points_h = hits.points.reshape(-1, 3)[self.hp]
         self.normals_h = self.geo.normals[self.tri_h]
         missing = len(flat_tri) - len(self.hp)
@@ -216,7 +220,7 @@ class _Removal:
         e_all = t_with @ b
         e = e_all[patch_rows]
         e_floor = 1e-9 * max(float((e @ LUMA).max()), 1e-30)
-        keys = surface_keys(geo)[lat.patch_tri]
+        keys = self.surface_key[lat.patch_tri]
         unseen = ~visible
         for _ in range(3):
             refl = recover_reflectance(b, e, visible, e_floor, (e_all @ LUMA)[test_rows].max(axis=1))
@@ -240,25 +244,26 @@ class _Removal:
         return _Room(lat, senders, important, visible, refl.emitter, rho, areas, receivers, receiver_normals, t_with,
                      t_without, patch_rows)
 
-    def _seen(self, points: np.ndarray, others: bool = True) -> np.ndarray:
-        """(N,) whether the probe (the origin) sees each point (past the removed object only,
-        unless `others`)."""
+    def _seen(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(N,) whether the probe (the origin) sees each point past the removed object, and
+        (N,) whether it sees it at all."""
         probe = np.zeros_like(points)
-        seen = ~self.occ_removed.blocked(probe, points)
-        if others and self.occ_others is not None:
-            seen &= ~self.occ_others.blocked(probe, points)
-        return seen
+        past_object = ~self.occ_removed.blocked(probe, points)
+        if self.occ_others is None:
+            return past_object, past_object
+        return past_object, past_object & ~self.occ_others.blocked(probe, points)
 
     def _transport(self, points: np.ndarray, normals: np.ndarray, senders: Senders) -> tuple[np.ndarray, np.ndarray]:
         return transport(points, normals, senders, self.occ_removed, self.occ_others, self.check)
 
-    def _sample(self, room: _Room, idx: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    def _sample(self, room: _Room, idx: np.ndarray, k: int):
         """k^2 points on each patch idx (n*k^2, 3), their normals, transport with and without the
-        object, and whether the probe sees them (n, k^2, 1)."""
+        object, and whether the probe sees them past the object and at all (each (n, k^2, 1))."""
         pts = triangle_samples(room.lattice.patch_triangles()[idx], k).reshape(-1, 3)
         nrm = np.repeat(room.senders.normals[idx], k * k, axis=0)
         tw, two = self._transport(pts, nrm, room.senders)
-        return pts, nrm, tw, two, self._seen(pts).reshape(len(idx), k * k, 1)
+        past_object, seen = (v.reshape(len(idx), k * k, 1) for v in self._seen(pts))
+        return pts, nrm, tw, two, past_object, seen
 
     def first_order_patches(self, room: _Room) -> np.ndarray:
         """(P, 3) first-order change of irradiance, averaged over each patch.
@@ -282,7 +287,7 @@ class _Removal:
         self.rep.info["refined_patches"] = int(len(refine))
         if not len(refine):
             return room.patch_mean((room.t_without - room.t_with) @ b)
-        pts, nrm, tw, two, seen = self._sample(room, refine, prm.patch_samples)
+        pts, nrm, tw, two, past_object, seen = self._sample(room, refine, prm.patch_samples)
         n, k2 = seen.shape[:2]
         e_s = (tw @ b).reshape(n, k2, 3)
         n_seen = seen.sum(axis=1)
@@ -293,7 +298,7 @@ class _Removal:
 
         # Only the object's cover differs between T and T'; a centroid under the object hides
         # the patch from receivers that see most of it.
-        under = ~self._seen(pts, others=False).reshape(n, k2).all(axis=1) | ~self._seen(centre[refine], others=False)
+        under = ~past_object.all(axis=(1, 2)) | ~self._seen(centre[refine])[0]
         partial = refine[under]
         de_partial = None
         if len(partial):
@@ -309,7 +314,7 @@ class _Removal:
         """Patches idx as senders sampled at k^2 points weighted by their light, dark where the
         probe cannot see and the estimate says so; (n, 3) their first-order change of E."""
         b = room.senders.radiosity
-        pts, nrm, tw, two, seen = self._sample(room, idx, k)
+        pts, nrm, tw, two, _, seen = self._sample(room, idx, k)
         e_s = (tw @ b).reshape(len(idx), k * k, 3)
         b_s = np.where(seen, b[idx, None, :], room.rho[idx, None, :] * e_s)
         b[idx] = b_s.mean(axis=1)
@@ -418,25 +423,21 @@ class _Removal:
         surface once it is gone): synthesised reflectance lit by the irradiance after removal."""
         geo, prm = self.geo, self.params
         b = room.senders.radiosity
-        if not len(self.revealed):
-            return np.zeros((0, 3))
         tri, bary, points = self.rev_tri, self.rev_bary, self.rev_points
         _, tf_w, inverse, weights = self._fine_transport(room, tri, bary)
         patch, corners, w_coarse = room.lattice.locate(tri, bary)
         e_new = _interp(tf_w @ b, inverse, weights) + _interp(de_prop_v, self.vertex_row[corners], w_coarse)
         e_new = np.maximum(e_new, 0.0)
 
-        keys = surface_keys(geo)
+        keys = self.surface_key
         n = self.height * self.width
         surface_with = np.full(n, -1, dtype=np.int64)
         surface_with[self.hp] = keys[self.tri_h]
         has = self.tri_without >= 0
         surface_without = np.where(has, keys[np.maximum(self.tri_without, 0)], -1)
-        hidden_map = np.zeros(n, dtype=bool)
-        hidden_map[self.hp[self.hidden_h]] = True
         shape = (self.height, self.width)
         maps = PanoramaMaps(surface_with.reshape(shape), self.hits.distance, surface_without.reshape(shape),
-                            self.distance_without.reshape(shape), hidden_map.reshape(shape))
+                            self.distance_without.reshape(shape), self.hidden_map)
         radiance = self.hdri.reshape(-1, 3)[self.hp].astype(np.float64)
         e_ref = float(np.median(e_pix @ LUMA))
         measured = ~self.hidden_h & ~self.emitter_h & ((e_pix @ LUMA) > 1e-3 * e_ref)
@@ -557,9 +558,6 @@ def remove(
         difference = np.zeros((h * w, 3), dtype=np.float32)
         difference[job.hp] = d
         difference = difference.reshape(h, w, 3)
-        hidden = np.zeros(h * w, dtype=bool)
-        hidden[job.hp[job.hidden_h]] = True
-        hidden = hidden.reshape(h, w)
         edited = (scene.hdri + difference).astype(np.float32)
     rep.info["hidden_region_filled"] = bool(len(job.revealed) == job.hidden_h.sum())
-    return RemovalResult(difference=difference, edited=edited, hidden_mask=hidden, report=rep.as_dict())
+    return RemovalResult(difference=difference, edited=edited, hidden_mask=job.hidden_map, report=rep.as_dict())
