@@ -37,17 +37,22 @@ _PASS_THROUGH_BLENDS = frozenset({"MIX", "ADD"})
 _DIRECTION_OUTPUTS = frozenset({"Generated", "Object"})
 
 
-def read_scene(scene: bpy.types.Scene, center: Sequence[float] | None = None) -> SceneData:
+def read_scene(scene: bpy.types.Scene, center: Sequence[float] | None = None,
+               exclude: Sequence[str] = (), defer_file: bool = False) -> SceneData:
     """Everything the engine needs from `scene`, as numpy arrays in world space.
 
-    center overrides the probe centre the scene defines (see `probe_center`).
+    center overrides the probe centre the scene defines (see `probe_center`). Objects named in
+    `exclude` are left out of the geometry (objects already removed from the panorama). With
+    `defer_file`, a panorama that can be read straight from its EXR file is not read here:
+    `hdri` is None and `hdri_path` names the file (`removal_job.loaded` reads it later), which
+    keeps Blender's main thread free of the file's decoding.
     """
     notes: list[str] = []
     node = environment_texture(scene)
     rotation = texture_rotation(node)
-    hdri, path = _panorama(node.image, notes)
+    hdri, path = _panorama(node.image, notes, defer_file)
     centre = probe_center(scene, center, notes)
-    triangles, tri_object, names = _geometry(scene, notes)
+    triangles, tri_object, names = _geometry(scene, notes, frozenset(exclude))
     return SceneData(
         hdri=hdri,
         rotation=rotation,
@@ -249,8 +254,10 @@ def _is_own(node: bpy.types.Node) -> bool:
     return node.name.startswith(OWN_NODE_PREFIX) or node.label.startswith(OWN_NODE_PREFIX)
 
 
-def _panorama(image: bpy.types.Image, notes: list[str]) -> tuple[np.ndarray, str]:
-    """(H, W, 3) float32 linear RGB, top row first, as Cycles renders `image`; and its path."""
+def _panorama(image: bpy.types.Image, notes: list[str], defer_file: bool = False) -> tuple[np.ndarray | None, str]:
+    """(H, W, 3) float32 linear RGB, top row first, as Cycles renders `image`; and its path.
+
+    With `defer_file`, None instead of the pixels when they are exactly the EXR file's."""
     if image.source not in ("FILE", "GENERATED"):
         raise DimredError(f"image '{image.name}' is a {image.source.lower()} image: use a single panorama file")
     path = ""
@@ -261,7 +268,7 @@ def _panorama(image: bpy.types.Image, notes: list[str]) -> tuple[np.ndarray, str
     colour = image.colorspace_settings
     if _is_exact_file(image, path):
         # Blender's buffer holds the same values; the file is read to skip Blender's image cache.
-        return read_exr(path), path
+        return (None if defer_file else read_exr(path)), path
     count = len(image.pixels)
     width, height = image.size
     if count == 0 or width * height == 0:
@@ -386,9 +393,11 @@ def _view_layer(scene: bpy.types.Scene) -> bpy.types.ViewLayer:
     return scene.view_layers[0]
 
 
-def _geometry(scene: bpy.types.Scene, notes: list[str]) -> tuple[np.ndarray, np.ndarray, list[str]]:
-    """World-space triangles of every render-visible object that evaluates to a mesh."""
-    visible = sorted(_render_visible_objects(scene), key=lambda obj: obj.name)
+def _geometry(scene: bpy.types.Scene, notes: list[str],
+              exclude: frozenset[str] = frozenset()) -> tuple[np.ndarray, np.ndarray, list[str]]:
+    """World-space triangles of every render-visible object that evaluates to a mesh, except `exclude`."""
+    visible = sorted((obj for obj in _render_visible_objects(scene) if obj.name not in exclude),
+                     key=lambda obj: obj.name)
     depsgraph = _view_layer(scene).depsgraph
     depsgraph.update()
     names: list[str] = []

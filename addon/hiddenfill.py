@@ -9,11 +9,12 @@ the hole.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
 from . import planeraster as PR
-from .errors import DimredError
+from .errors import Cancelled, DimredError
 from .synthesis import SynthesisParams, fill
 
 _MAX_CELLS = 512 * 512  # bounds the raster (and the exemplar) whatever the panorama size
@@ -54,11 +55,13 @@ def fill_surface(
     margin: float,
     params: SynthesisParams,
     seed: int = 0,
-    cancel=None,
+    cancel: Callable[[], bool] | None = None,
+    progress: Callable[[np.ndarray], None] | None = None,
 ) -> SurfaceFill:
     """Reflectance at the hidden `points` (N, 3) of one plane, synthesised on a raster with cells
     of about `cell` covering them and `margin` times their extent around, from the panorama's
-    reflectance `rho_image` (H, W, 3) where `rho_valid`."""
+    reflectance `rho_image` (H, W, 3) where `rho_valid`. `progress(rho)` gets the (N, 3)
+    reflectance at `points` after each synthesis level, coarsest first."""
     raster = PR.build_raster(normal, points, cell, margin, _MAX_CELLS)
     flags = PR.classify(raster, maps.surface_with, maps.distance_with, maps.surface_without,
                         maps.distance_without, maps.hidden, surface, _DEPTH_TOLERANCE)
@@ -77,9 +80,13 @@ def fill_surface(
     image = np.where(known[..., None], values, mean)
     synthesised = False
     if known.sum() >= _MIN_KNOWN:
+        on_level = None if progress is None else (
+            lambda _level, preview: progress(PR.sample_raster(raster, preview, points)))
         try:
-            image = fill(image, known, hole, params, seed=seed, cancel=cancel)
+            image = fill(image, known, hole, params, seed=seed, progress=on_level, cancel=cancel)
             synthesised = True
+        except Cancelled:
+            raise
         except DimredError:
             pass  # too little exemplar: the mean below is the honest fallback, reported by the caller
     rho = PR.sample_raster(raster, image, points)

@@ -17,6 +17,8 @@ from .scene import SceneData
 def validate(scene: SceneData) -> None:
     """DimredError for input the engine cannot work with (one line saying what)."""
     hdri = scene.hdri
+    if hdri is None:
+        raise DimredError("the panorama's pixels were not read (load the deferred file first)")
     if hdri.ndim != 3 or hdri.shape[2] != 3 or hdri.shape[0] < 2 or hdri.shape[1] < 4:
         raise DimredError(f"the world image must be an RGB panorama, got an array of shape {hdri.shape}")
     if hdri.shape[1] != 2 * hdri.shape[0]:
@@ -36,12 +38,15 @@ def remove_object(
     quality: str = "balanced",
     progress: Callable[[str, float], None] | None = None,
     cancel: Callable[[], bool] | None = None,
+    preview: Callable[[np.ndarray], None] | None = None,
     **overrides,
 ) -> RemovalResult:
-    """Remove `object_name` from the scene's panorama; `overrides` change single parameters."""
+    """Remove `object_name` from the scene's panorama; `overrides` change single parameters.
+
+    `preview(difference)` gets coarse difference images before the result (see `removal.remove`)."""
     validate(scene)
     params = params_for(quality, **overrides)
-    result = remove(scene, object_name, list(planes), params, progress, cancel)
+    result = remove(scene, object_name, list(planes), params, progress, cancel, preview)
     result.report["quality"] = quality
     result.report["parameters"] = {k: getattr(params, k) for k in params.__dataclass_fields__}
     result.report["image_size"] = [int(scene.hdri.shape[1]), int(scene.hdri.shape[0])]

@@ -418,9 +418,13 @@ class _Removal:
         self.rep.info["exact_pairs"] = int(len(s))
         return e_pix, de_pix
 
-    def fill_hidden(self, room: _Room, e_pix: np.ndarray, de_prop_v: np.ndarray) -> np.ndarray:
+    def fill_hidden(self, room: _Room, e_pix: np.ndarray, de_prop_v: np.ndarray,
+                    show: Callable[[np.ndarray], None] | None = None) -> np.ndarray:
         """(N, 3) radiance change of the revealed pixels (those that saw the object and see a
-        surface once it is gone): synthesised reflectance lit by the irradiance after removal."""
+        surface once it is gone): synthesised reflectance lit by the irradiance after removal.
+
+        `show(change)` gets the revealed pixels' change as the fill refines: first with each
+        patch's mean reflectance, then after every synthesis level of every surface."""
         geo, prm = self.geo, self.params
         b = room.senders.radiosity
         tri, bary, points = self.rev_tri, self.rev_bary, self.rev_points
@@ -456,12 +460,28 @@ class _Removal:
         synth = SynthesisParams(neighbourhood=prm.synth_neighbourhood, levels=prm.synth_levels,
                                 generations=prm.synth_generations)
         rho = room.rho[patch].copy()
+        emit = room.emitter[patch]
+
+        def change() -> np.ndarray:
+            new = rho * e_new / np.pi
+            # A light behind the object shines on with the radiosity its patch was given.
+            new[emit] = b[patch[emit]] / np.pi
+            return new - radiance[self.revealed]
+
+        if show is not None:
+            show(change())
         surfaces = []
         for key in np.unique(keys[tri]):
             sel = np.flatnonzero(keys[tri] == key)
             self.check()
+
+            def level_shown(level_rho: np.ndarray, sel: np.ndarray = sel) -> None:
+                rho[sel] = level_rho
+                show(change())
+
             got = fill_surface(maps, rho_image, valid, int(key), geo.normals[tri[sel[0]]], points[sel], cell,
-                               prm.exemplar_margin, synth, seed=prm.seed, cancel=self.cancel)
+                               prm.exemplar_margin, synth, seed=prm.seed, cancel=self.cancel,
+                               progress=None if show is None else level_shown)
             name = geo.object_names[geo.tri_object[tri[sel[0]]]]
             if got.known_cells:
                 rho[sel] = got.rho
@@ -472,11 +492,7 @@ class _Removal:
                                  cell=round(got.cell, 5), known_cells=got.known_cells,
                                  hole_cells=got.hole_cells, synthesised=got.synthesised))
         self.rep.info["filled_surfaces"] = surfaces
-        new = rho * e_new / np.pi
-        # A light behind the object shines on with the radiosity its patch was given.
-        emit = room.emitter[patch]
-        new[emit] = b[patch[emit]] / np.pi
-        return new - radiance[self.revealed]
+        return change()
 
     def compose(self, e_pix: np.ndarray, de_pix: np.ndarray) -> np.ndarray:
         """(N, 3) radiance change of the hit pixels from the ratio form, with guards counted."""
@@ -505,8 +521,12 @@ def remove(
     params: Params | None = None,
     progress: Callable[[str, float], None] | None = None,
     cancel: Callable[[], bool] | None = None,
+    preview: Callable[[np.ndarray], None] | None = None,
 ) -> RemovalResult:
-    """Remove `object_name`'s shadows and reflected light from the scene's panorama."""
+    """Remove `object_name`'s shadows and reflected light from the scene's panorama.
+
+    `preview(difference)` gets (H, W, 3) float32 difference images before the result: the
+    lighting corrected with the hidden region roughly filled, then refined level by level."""
     params = params or Params()
     rep = Report(progress, stages=8)
     check = _cancel_check(cancel)
@@ -543,21 +563,24 @@ def remove(
     check()
     with rep.stage("local"):
         e_pix, de_pix = job.local(room)
+    with rep.stage("compose"):
+        d = job.compose(e_pix, de_pix + _interp(de_prop_v, job.corners_h, job.weights_h))
+
+    def difference_image(d_revealed: np.ndarray) -> np.ndarray:
+        d[job.revealed] = d_revealed
+        image = np.zeros((job.height * job.width, 3), dtype=np.float32)
+        image[job.hp] = d
+        return image.reshape(job.height, job.width, 3)
+
     if len(job.revealed):
+        show = None if preview is None else lambda d_revealed: preview(difference_image(d_revealed))
         with rep.stage("synthesis"):
-            d_revealed = job.fill_hidden(room, e_pix, de_prop_v)
+            d_revealed = job.fill_hidden(room, e_pix, de_prop_v, show)
     else:
         d_revealed = np.zeros((0, 3))
         rep.skip("synthesis", "the object is not visible from the probe centre: no hidden region to fill"
                  if not job.hidden_h.any() else "nothing is behind the object to fill")
-    with rep.stage("compose"):
-        de_pix = de_pix + _interp(de_prop_v, job.corners_h, job.weights_h)
-        d = job.compose(e_pix, de_pix)
-        d[job.revealed] = d_revealed
-        h, w = job.height, job.width
-        difference = np.zeros((h * w, 3), dtype=np.float32)
-        difference[job.hp] = d
-        difference = difference.reshape(h, w, 3)
-        edited = (scene.hdri + difference).astype(np.float32)
+    difference = difference_image(d_revealed)
+    edited = (scene.hdri + difference).astype(np.float32)
     rep.info["hidden_region_filled"] = bool(len(job.revealed) == job.hidden_h.sum())
     return RemovalResult(difference=difference, edited=edited, hidden_mask=job.hidden_map, report=rep.as_dict())

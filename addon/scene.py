@@ -14,7 +14,8 @@ import numpy as np
 class SceneData:
     """Everything the removal needs, read once from Blender on the main thread.
 
-    hdri: (H, W, 3) float32 linear radiance, row 0 = top of the panorama (v = 1, up).
+    hdri: (H, W, 3) float32 linear radiance, row 0 = top of the panorama (v = 1, up); None
+        while still to be read from `hdri_path` (`bridge.read_scene(defer_file=True)`).
     rotation: (3, 3) matrix R; the world direction d samples the texture at R @ d
         (identity without a Mapping node).
     center: (3,) probe centre.
@@ -24,7 +25,7 @@ class SceneData:
     hdri_path: the world image's file path (for the report), may be empty.
     """
 
-    hdri: np.ndarray
+    hdri: np.ndarray | None
     rotation: np.ndarray
     center: np.ndarray
     triangles: np.ndarray

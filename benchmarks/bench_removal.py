@@ -8,7 +8,6 @@ are noisy: compare presets within one run.
 """
 from __future__ import annotations
 
-import argparse
 import sys
 import time
 from pathlib import Path
@@ -17,29 +16,22 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from rendered import arguments, open_scene  # noqa: E402
 from scenes import metrics as M  # noqa: E402
-from scenes import spec as S  # noqa: E402
-from scenes.render import render_pair  # noqa: E402
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--scene", default="basic_box")
-    ap.add_argument("--width", type=int, default=1024)
-    ap.add_argument("--samples", type=int, default=16)
+    ap = arguments(__doc__)
     ap.add_argument("--presets", default="draft,balanced,final")
     args = ap.parse_args()
-    spec = S.get(args.scene).with_render(width=args.width, height=args.width // 2, samples=args.samples)
-    paths = render_pair(spec)
+    spec, paths = open_scene(args)
 
-    import bpy  # noqa: F401  (the bridge needs Blender; imported after rendering in a subprocess)
+    import bpy
 
     from addon import bridge
-    from addon.cli import open_blend
     from addon.pipeline import remove_object
     from scenes.images import read_exr
 
-    open_blend(str(paths["blend"]))
     t0 = time.perf_counter()
     scene = bridge.read_scene(bpy.context.scene)
     read_s = time.perf_counter() - t0

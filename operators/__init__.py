@@ -1,10 +1,10 @@
 """The `scene.dimred` settings and the `bpy.ops.dimred.*` operators, registered in order."""
 from __future__ import annotations
 
-from . import marking, removal, settings
+from . import marking, removal, session, settings
 
 # Settings first: the operators and the panel read scene.dimred.
-_modules = (settings, marking, removal)
+_modules = (settings, session, marking, removal)
 
 
 def register() -> None:

@@ -1,40 +1,23 @@
-"""Operators that run the removal and manage its result: remove, clear, save HDRI.
+"""Operators that run the removal and manage its result: remove, cancel, clear, save HDRI.
 
-This first version runs synchronously on the main thread. The engine (`addon.bridge`,
-`addon.pipeline`, `addon.exr`) is imported inside `execute`, so registering the add-on costs
-nothing and does not depend on it.
+Remove invoked from the UI computes in a worker thread (`session.RemovalSession`) while a modal
+operator polls it on a timer, shows progress in the panel and the status bar, and previews the
+result in the world as it refines; Esc or the panel's Cancel stops it and leaves the scene as it
+was. Called from a script or in background mode (`blender -b`), the same operator runs to the
+end synchronously. The engine is imported only when a run starts, so registering costs nothing.
 """
 from __future__ import annotations
-
-import json
-import os
 
 import bpy
 from bpy.props import BoolProperty, StringProperty
 
 from ..addon.errors import DimredError
+from . import session as S
 from . import world_layer
 
-
-def _probe_center(settings: bpy.types.PropertyGroup) -> tuple[float, float, float] | None:
-    # None lets the bridge apply the contract's fallbacks (an Empty named ProbeCenter, the origin).
-    return tuple(settings.probe_center) if settings.use_probe_center else None
-
-
-def output_folder(settings: bpy.types.PropertyGroup) -> str:
-    """The absolute output folder; a '//' path needs a saved .blend to be relative to."""
-    raw = settings.output_dir.strip() or "//"
-    if raw.startswith("//") and not bpy.data.filepath:
-        raise DimredError(
-            f"The output folder '{raw}' is relative to the .blend file, which is not saved yet: "
-            "save it first or choose an absolute folder"
-        )
-    return os.path.normpath(bpy.path.abspath(raw))
-
-
-def difference_filename(world: bpy.types.World) -> str:
-    """One difference file per world, so scenes sharing an output folder do not collide."""
-    return f"{bpy.path.clean_name(world.name)}_difference.exr"
+# Seconds between the modal operator's polls of the worker: fast enough that Esc acts at once
+# and progress moves smoothly, slow enough to cost nothing.
+POLL_INTERVAL = 0.05
 
 
 def _world_poll(cls: type[bpy.types.Operator], context: bpy.types.Context) -> bool:
@@ -44,24 +27,18 @@ def _world_poll(cls: type[bpy.types.Operator], context: bpy.types.Context) -> bo
     return True
 
 
-def report_summary(report: dict) -> str:
-    """One line about a run's report dict (fields per the command line's report.json)."""
-    total = report.get("seconds", {}).get("total")
-    parts = [f"{total:.1f} s" if isinstance(total, (int, float)) else "done"]
-    for key, label in (("skipped", "stages skipped"), ("warnings", "warnings")):
-        if report.get(key):
-            parts.append(f"{len(report[key])} {label}")
-    return ", ".join(parts)
-
-
 class DIMRED_OT_remove(bpy.types.Operator):
     bl_idname = "dimred.remove"
     bl_label = "Remove Object"
     bl_description = (
         "Compute the difference image that removes the marked object, its shadow and its reflected "
-        "light from the panorama, and show HDRI + difference in the world"
+        "light from the panorama, and show HDRI + difference in the world. Runs in the background "
+        "with progress; Esc cancels"
     )
     bl_options = {'REGISTER', 'UNDO'}
+
+    _timer = None
+    _session: S.RemovalSession | None = None
 
     @classmethod
     def poll(cls, context: bpy.types.Context) -> bool:
@@ -70,44 +47,84 @@ class DIMRED_OT_remove(bpy.types.Operator):
         if context.scene.dimred.target is None:
             cls.poll_message_set("Mark the object to remove first")
             return False
+        if S.active() is not None:
+            cls.poll_message_set("A removal is already running: wait for it or cancel it")
+            return False
         return True
 
     def execute(self, context: bpy.types.Context) -> set[str]:
-        scene = context.scene
-        settings, world = scene.dimred, scene.world
         try:
-            folder = output_folder(settings)
-            # Check the world before the long computation, not after it.
-            world_layer.world_nodes(world)
-            from ..addon import bridge, exr, pipeline
-
-            # The same checks as the command line, so both refuse the same input.
-            bridge.check_object(scene, settings.target.name)
-            for name in settings.surface_names():
-                bridge.check_object(scene, name, purpose="used as a target surface")
-            scene_data = bridge.read_scene(scene, _probe_center(settings))
-            result = pipeline.remove_object(
-                scene_data,
-                settings.target.name,
-                planes=settings.surface_names(),
-                quality=settings.quality,
-            )
-            os.makedirs(folder, exist_ok=True)
-            path = os.path.join(folder, difference_filename(world))
-            exr.write_exr(path, result.difference)
+            run = S.RemovalSession.begin(context)
         except DimredError as error:
             self.report({'ERROR'}, str(error))
             return {'CANCELLED'}
-        except OSError as error:
-            self.report({'ERROR'}, f"Could not write the difference image: {error}")
-            return {'CANCELLED'}
+        return self._finish(run, run.run_here(context))
 
-        # A folder given relative to the .blend stays relative, so the file can move with it.
-        relative = settings.output_dir.strip().startswith("//")
-        image_path = bpy.path.relpath(path) if relative else path
-        world_layer.add_layer(world, world_layer.load_difference_image(image_path, difference_filename(world)))
-        settings.last_report = json.dumps(result.report)
-        self.report({'INFO'}, f"Removed '{settings.target.name}': {report_summary(result.report)}; wrote {path}")
+    def invoke(self, context: bpy.types.Context, event: bpy.types.Event) -> set[str]:
+        if bpy.app.background or context.window is None:
+            return self.execute(context)
+        try:
+            self._session = S.RemovalSession.begin(context)
+        except DimredError as error:
+            self.report({'ERROR'}, str(error))
+            return {'CANCELLED'}
+        self._session.start()
+        wm = context.window_manager
+        self._timer = wm.event_timer_add(POLL_INTERVAL, window=context.window)
+        wm.modal_handler_add(self)
+        self._status(context)
+        return {'RUNNING_MODAL'}
+
+    def modal(self, context: bpy.types.Context, event: bpy.types.Event) -> set[str]:
+        run = self._session
+        if event.type == 'ESC' or run.worker.cancelled:
+            run.cancel(context)
+            return self._finish(run, False, context)
+        if event.type != 'TIMER':
+            return {'PASS_THROUGH'}
+        state = run.tick(context)
+        if state == 'RUNNING':
+            self._status(context)
+            return {'RUNNING_MODAL'}
+        return self._finish(run, state == 'FINISHED', context)
+
+    def cancel(self, context: bpy.types.Context) -> None:
+        # Blender ends the modal operator (file load, window closed): stop the worker first.
+        if self._session is not None:
+            self._session.cancel(context)
+            self._finish(self._session, False, context)
+
+    def _status(self, context: bpy.types.Context) -> None:
+        run = self._session
+        context.workspace.status_text_set(
+            f"Diminished Reality: {run.stage.replace('_', ' ')} {100 * run.fraction:.0f} %   (Esc to cancel)")
+
+    def _finish(self, run: S.RemovalSession, ok: bool, context: bpy.types.Context | None = None) -> set[str]:
+        if self._timer is not None and context is not None:
+            context.window_manager.event_timer_remove(self._timer)
+            self._timer = None
+            context.workspace.status_text_set(None)
+        self._session = None
+        self.report({'INFO'} if ok else {'ERROR'}, run.message)
+        return {'FINISHED'} if ok else {'CANCELLED'}
+
+
+class DIMRED_OT_cancel(bpy.types.Operator):
+    bl_idname = "dimred.cancel"
+    bl_label = "Cancel Removal"
+    bl_description = "Stop the running removal; the world stays as it was before it started"
+    bl_options = {'INTERNAL'}
+
+    @classmethod
+    def poll(cls, context: bpy.types.Context) -> bool:
+        if S.active() is None:
+            cls.poll_message_set("No removal is running")
+            return False
+        return True
+
+    def execute(self, context: bpy.types.Context) -> set[str]:
+        # The modal operator sees the request at its next poll and rolls back there.
+        S.active().worker.cancel()
         return {'FINISHED'}
 
 
@@ -121,15 +138,21 @@ class DIMRED_OT_clear(bpy.types.Operator):
     def poll(cls, context: bpy.types.Context) -> bool:
         if not _world_poll(cls, context):
             return False
-        if not world_layer.has_layer(context.scene.world):
+        if S.active() is not None:
+            cls.poll_message_set("A removal is running: cancel it first")
+            return False
+        if not world_layer.has_layer(context.scene.world) and not len(context.scene.dimred.removals):
             cls.poll_message_set("The world shows no removal")
             return False
         return True
 
     def execute(self, context: bpy.types.Context) -> set[str]:
-        image = world_layer.remove_layer(context.scene.world)
-        if image is not None and image.users == 0:
-            bpy.data.images.remove(image)
+        settings = context.scene.dimred
+        images = [world_layer.remove_layer(context.scene.world)] + [r.image for r in settings.removals]
+        settings.removals.clear()
+        for image in images:
+            if image is not None and image.name in bpy.data.images and image.users == 0:
+                bpy.data.images.remove(image)
         self.report({'INFO'}, "Removal cleared: the world shows the original panorama")
         return {'FINISHED'}
 
@@ -147,6 +170,9 @@ class DIMRED_OT_save_hdri(bpy.types.Operator):
     @classmethod
     def poll(cls, context: bpy.types.Context) -> bool:
         if not _world_poll(cls, context):
+            return False
+        if S.active() is not None:
+            cls.poll_message_set("A removal is running: wait for it to finish")
             return False
         if world_layer.layer_image(context.scene.world) is None:
             cls.poll_message_set("Run Remove first: there is no difference to add")
@@ -169,7 +195,7 @@ class DIMRED_OT_save_hdri(bpy.types.Operator):
             from ..addon import bridge, exr
 
             difference = world_layer.image_rgb(world_layer.layer_image(scene.world))
-            hdri = bridge.read_scene(scene, _probe_center(scene.dimred)).hdri
+            hdri = bridge.read_scene(scene, S.probe_center(scene.dimred)).hdri
             if hdri.shape != difference.shape:
                 raise DimredError(
                     f"The difference image is {difference.shape[1]}x{difference.shape[0]} but the HDRI is "
@@ -186,6 +212,6 @@ class DIMRED_OT_save_hdri(bpy.types.Operator):
         return {'FINISHED'}
 
 
-classes = (DIMRED_OT_remove, DIMRED_OT_clear, DIMRED_OT_save_hdri)
+classes = (DIMRED_OT_remove, DIMRED_OT_cancel, DIMRED_OT_clear, DIMRED_OT_save_hdri)
 
 register, unregister = bpy.utils.register_classes_factory(classes)

@@ -28,6 +28,16 @@ class DimredSurface(bpy.types.PropertyGroup):
     object: PointerProperty(name="Surface", type=bpy.types.Object, poll=_is_mesh)
 
 
+class DimredRemoval(bpy.types.PropertyGroup):
+    """One object removed from the panorama, in order, with its own difference image.
+
+    The world layer shows the sum of all of them; a later removal works on HDRI + the earlier ones.
+    """
+
+    object_name: StringProperty(name="Object", description="The removed object")
+    image: PointerProperty(name="Difference", description="This removal's own difference image", type=bpy.types.Image)
+
+
 class DimredSettings(bpy.types.PropertyGroup):
     """What to remove, from where the panorama was taken, and how carefully."""
 
@@ -63,6 +73,20 @@ class DimredSettings(bpy.types.PropertyGroup):
         subtype='DIR_PATH',
         default="//dimred/",
     )
+    storage: EnumProperty(
+        name="Store Result",
+        items=(
+            ("FILE", "Beside the File", "Write the difference images into the output folder; the .blend refers to them"),
+            ("PACK", "Packed", "Pack the difference images into the .blend: one self-contained file, larger to save"),
+        ),
+        default="FILE",
+        description="Where the difference images live so that saving and reopening the .blend keeps the result",
+    )
+    removals: CollectionProperty(
+        name="Removals",
+        description="The objects removed so far, in order; the world shows all of them",
+        type=DimredRemoval,
+    )
     last_report: StringProperty(
         name="Last Report",
         description="The last removal's report, as JSON",
@@ -74,7 +98,7 @@ class DimredSettings(bpy.types.PropertyGroup):
         return tuple(item.object.name for item in self.surfaces if item.object is not None)
 
 
-classes = (DimredSurface, DimredSettings)
+classes = (DimredSurface, DimredRemoval, DimredSettings)
 
 
 def register() -> None:

@@ -5,7 +5,7 @@ import json
 
 import bpy
 
-from ..operators import world_layer
+from ..operators import session, world_layer
 
 CATEGORY = "Diminished Reality"
 
@@ -46,14 +46,29 @@ class DIMRED_PT_main(bpy.types.Panel):
         box.operator("dimred.mark_surface", icon='CHECKBOX_HLT')
 
         layout.prop(settings, "quality")
-        layout.prop(settings, "output_dir")
+        layout.prop(settings, "storage")
+        row = layout.row()
+        row.enabled = settings.storage == 'FILE'
+        row.prop(settings, "output_dir")
 
+        running = session.active()
         column = layout.column(align=True)
         column.scale_y = 1.4
-        column.operator("dimred.remove", icon='TRASH')
+        if running is None:
+            column.operator("dimred.remove", icon='TRASH')
+        else:
+            row = column.row(align=True)
+            row.progress(factor=running.fraction, type='BAR',
+                         text=f"{running.stage.replace('_', ' ').capitalize()} {100 * running.fraction:.0f} %")
+            row.operator("dimred.cancel", text="", icon='CANCEL')
         row = layout.row(align=True)
         row.operator("dimred.clear", icon='X')
         row.operator("dimred.save_hdri", icon='FILE_IMAGE')
+        if len(settings.removals):
+            column = layout.column(align=True)
+            column.label(text="Removed, in order:")
+            for entry in settings.removals:
+                column.label(text=entry.object_name, icon='GHOST_ENABLED')
 
 
 class DIMRED_PT_last_run(bpy.types.Panel):

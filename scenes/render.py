@@ -7,6 +7,7 @@ interrupted or failed render never leaves a partial entry behind.
 """
 from __future__ import annotations
 
+import fcntl
 import os
 import shutil
 import subprocess
@@ -41,6 +42,17 @@ def render_pair(spec: SceneSpec, cache_root: Path = CACHE_ROOT,
     if all(p.exists() for p in paths.values()):
         return paths
     cache_root.mkdir(parents=True, exist_ok=True)
+    # One Cycles render at a time across processes: two would share the cores and both crawl.
+    with open(cache_root / ".render.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if all(p.exists() for p in paths.values()):
+            return paths
+        _render_into_cache(spec, paths, cache_root, timeout)
+    return paths
+
+
+def _render_into_cache(spec: SceneSpec, paths: dict[str, Path], cache_root: Path,
+                       timeout: float | None) -> None:
     work = Path(tempfile.mkdtemp(prefix=f"{spec.key()}.", suffix=".tmp", dir=cache_root))
     try:
         (work / FILES["spec"]).write_text(spec.to_json())
@@ -55,7 +67,6 @@ def render_pair(spec: SceneSpec, cache_root: Path = CACHE_ROOT,
     finally:
         if work.exists():
             shutil.rmtree(work)
-    return paths
 
 
 def render_world(blend: str | Path, out_exr: str | Path,

@@ -67,46 +67,10 @@ def render_world(tmp_path: Path):
     direction; the camera rotation (90, 0, -90) degrees makes the render's pixel directions
     those of `addon.latlong.pixel_directions`. Keep sizes tiny: the machine is shared.
     """
-    import math
-
-    import bpy
-
-    from addon.exr import read_exr
+    import tiny_scene
 
     def render(width: int, height: int, origin: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> np.ndarray:
-        scene = bpy.context.scene
-        camera_data = bpy.data.cameras.new("ProbeCamera")
-        camera_data.type = 'PANO'
-        camera_data.panorama_type = 'EQUIRECTANGULAR'
-        camera_data.longitude_min, camera_data.longitude_max = -math.pi, math.pi
-        camera_data.latitude_min, camera_data.latitude_max = -math.pi / 2, math.pi / 2
-        camera = bpy.data.objects.new("ProbeCamera", camera_data)
-        scene.collection.objects.link(camera)
-        camera.location = origin
-        camera.rotation_euler = (math.pi / 2, 0.0, -math.pi / 2)
-        scene.camera = camera
-        scene.render.engine = 'CYCLES'
-        scene.cycles.device = 'CPU'
-        scene.cycles.samples = 1
-        scene.cycles.use_adaptive_sampling = False
-        scene.cycles.use_denoising = False
-        scene.cycles.pixel_filter_type = 'BLACKMAN_HARRIS'
-        scene.cycles.filter_width = 0.01
-        scene.render.threads_mode = 'FIXED'
-        scene.render.threads = 2
-        scene.render.resolution_x, scene.render.resolution_y = width, height
-        scene.render.resolution_percentage = 100
-        scene.render.use_compositing = False
-        scene.render.use_sequencer = False
-        scene.view_settings.view_transform = 'Standard'
-        settings = scene.render.image_settings
-        settings.file_format = 'OPEN_EXR'
-        settings.color_depth = '32'
-        settings.color_mode = 'RGB'
-        scene.render.filepath = str(tmp_path / "render.exr")
-        bpy.ops.render.render(write_still=True)
-        bpy.data.objects.remove(camera)
-        return read_exr(tmp_path / "render.exr")
+        return tiny_scene.render_world(width, height, origin, tmp_path / "render.exr")
 
     return render
 

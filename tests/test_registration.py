@@ -8,7 +8,7 @@ from pathlib import Path
 import bpy
 import pytest
 
-OPERATORS = ("set_probe_center", "mark_remove", "mark_surface", "remove", "clear", "save_hdri")
+OPERATORS = ("set_probe_center", "mark_remove", "mark_surface", "remove", "cancel", "clear", "save_hdri")
 
 
 def _operator_exists(name: str) -> bool:
@@ -49,7 +49,8 @@ def test_registration_leaves_the_engine_unimported():
         capture_output=True, text=True,
     )
     assert result.returncode == 0, result.stderr
-    assert result.stdout.strip().splitlines()[-1] == "['dr.addon.errors']"
+    # The error type and the worker thread (standard library only) are all the operators need.
+    assert result.stdout.strip().splitlines()[-1] == "['dr.addon.errors', 'dr.addon.worker']"
 
 
 def test_operators_and_settings(registered):
@@ -198,6 +199,10 @@ class _CheckingLayout:
         self._icon(kwargs)
         self.drawn.append(f"label {kwargs.get('text', '')}")
 
+    def progress(self, factor: float, type: str, text: str) -> None:
+        assert 0.0 <= factor <= 1.0 and type in {'BAR', 'RING'}
+        self.drawn.append(f"progress {text}")
+
 
 def _draw(panel_class: type, context) -> list[str]:
     drawn: list[str] = []
@@ -206,14 +211,22 @@ def _draw(panel_class: type, context) -> list[str]:
     return drawn
 
 
-def test_panels_draw_existing_properties_operators_and_icons(registered):
+def test_panels_draw_existing_properties_operators_and_icons(registered, monkeypatch):
     from diminished_reality.panels import sidebar
 
     scene = bpy.context.scene
     scene.dimred.surfaces.add().object = _mesh("Floor")
     drawn = _draw(sidebar.DIMRED_PT_main, bpy.context)
-    assert {f"operator dimred.{name}" for name in OPERATORS} <= set(drawn)
-    assert "label Floor" in drawn
+    assert {f"operator dimred.{name}" for name in OPERATORS if name != "cancel"} <= set(drawn)
+    assert "label Floor" in drawn and "operator dimred.cancel" not in drawn
+
+    # While a removal runs, its progress bar and Cancel replace the Remove button.
+    running = type("Running", (), {"stage": "first_order", "fraction": 0.375})()
+    monkeypatch.setattr(sidebar.session, "active", lambda: running)
+    drawn = _draw(sidebar.DIMRED_PT_main, bpy.context)
+    assert "progress First order 38 %" in drawn and "operator dimred.cancel" in drawn
+    assert "operator dimred.remove" not in drawn
+    monkeypatch.undo()
 
     assert not sidebar.DIMRED_PT_last_run.poll(bpy.context)
     scene.dimred.last_report = (

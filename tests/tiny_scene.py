@@ -126,3 +126,51 @@ def build_scene(hdri_path: str | Path) -> None:
     environment.image = bpy.data.images.load(str(hdri_path))
     links.new(environment.outputs["Color"], background.inputs["Color"])
     bpy.context.scene.world = world
+
+
+def render_world(width: int, height: int, origin, path: str | Path) -> np.ndarray:
+    """Render the current scene's world with Cycles from `origin` through an equirectangular
+    panoramic camera into the EXR `path`; return (height, width, 3) float32, top row first.
+
+    One sample with a 0.01 px Blackman-Harris filter point-samples each pixel's centre
+    direction; the camera rotation (90, 0, -90) degrees makes the render's pixel directions
+    those of `addon.latlong.pixel_directions`. Keep sizes tiny: the machine is shared.
+    """
+    import math
+
+    import bpy
+
+    scene = bpy.context.scene
+    camera_data = bpy.data.cameras.new("ProbeCamera")
+    camera_data.type = 'PANO'
+    camera_data.panorama_type = 'EQUIRECTANGULAR'
+    camera_data.longitude_min, camera_data.longitude_max = -math.pi, math.pi
+    camera_data.latitude_min, camera_data.latitude_max = -math.pi / 2, math.pi / 2
+    camera = bpy.data.objects.new("ProbeCamera", camera_data)
+    scene.collection.objects.link(camera)
+    camera.location = origin
+    camera.rotation_euler = (math.pi / 2, 0.0, -math.pi / 2)
+    scene.camera = camera
+    scene.render.engine = 'CYCLES'
+    scene.cycles.device = 'CPU'
+    scene.cycles.samples = 1
+    scene.cycles.use_adaptive_sampling = False
+    scene.cycles.use_denoising = False
+    scene.cycles.pixel_filter_type = 'BLACKMAN_HARRIS'
+    scene.cycles.filter_width = 0.01
+    scene.render.threads_mode = 'FIXED'
+    scene.render.threads = 2
+    scene.render.resolution_x, scene.render.resolution_y = width, height
+    scene.render.resolution_percentage = 100
+    scene.render.use_compositing = False
+    scene.render.use_sequencer = False
+    scene.view_settings.view_transform = 'Standard'
+    settings = scene.render.image_settings
+    settings.file_format = 'OPEN_EXR'
+    settings.color_depth = '32'
+    settings.color_mode = 'RGB'
+    scene.render.filepath = str(path)
+    bpy.ops.render.render(write_still=True)
+    bpy.data.objects.remove(camera)
+    bpy.data.cameras.remove(camera_data)
+    return read_exr(path)

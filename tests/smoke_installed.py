@@ -1,9 +1,12 @@
-"""End-to-end smoke test of the built extension on Blender 4.2 LTS (bpy 4.2, Python 3.11, numpy 1.26).
+"""End-to-end test of the built extension, installed the way Blender installs extensions.
 
-`./dev test` runs it as `.venv311/bin/python tests/smoke_blender42.py [ZIP]`. It builds the
-extension zip with Blender 4.2's own `blender_ext.py` (or takes ZIP), installs and enables it
-into a throw-away user profile, and removes the box from a tiny procedural room twice: through
-the installed package's `blender -c dimred` command function and through `bpy.ops.dimred.remove`.
+`./dev test` runs it twice: from pytest on Blender 5.2 (`tests/test_installed.py`) and as
+`.venv311/bin/python tests/smoke_installed.py [ZIP]` on Blender 4.2 LTS (bpy 4.2, Python 3.11,
+numpy 1.26), the oldest Blender the manifest claims. It builds the extension zip with that
+Blender's own `blender_ext.py` (or takes ZIP), installs and enables it into a throw-away user
+profile, and removes the box from a tiny procedural room twice: through the installed package's
+`blender -c dimred` command function and through `bpy.ops.dimred.remove`, whose world layer a
+Cycles render from the probe centre must show exactly; then undo, redo and clear.
 Each step needs the ones before it, so the first failure ends the run. The closing line is
 `smoke: N passed, N failed`; the exit status is non-zero when a step failed.
 """
@@ -24,7 +27,7 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
 PACKAGE = "bl_ext.user_default.diminished_reality"
-OPERATORS = ("set_probe_center", "mark_remove", "mark_surface", "remove", "clear", "save_hdri")
+OPERATORS = ("set_probe_center", "mark_remove", "mark_surface", "remove", "cancel", "clear", "save_hdri")
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import tiny_scene  # noqa: E402  (next to this script, not a package)
@@ -34,7 +37,7 @@ def build_zip(out_dir: Path) -> Path:
     spec = importlib.util.spec_from_file_location("build_extension", ROOT / "scripts" / "build_extension.py")
     build_extension = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(build_extension)
-    # The bpy of this interpreter is 4.2: its blender_ext.py validates the manifest for 4.2.
+    # This interpreter's bpy validates the manifest for its own Blender version.
     (path,) = build_extension.build(out_dir)
     return path
 
@@ -50,9 +53,10 @@ def install(zip_path: Path) -> None:
     repo = next(r for r in bpy.context.preferences.extensions.repos if r.module == "user_default")
     installed = Path(repo.directory) / "diminished_reality"
     assert not (installed / "tests").exists() and (installed / "addon" / "latlong.py").is_file()
-    # Blender extracts the wheel matching its own Python (cp311 here) next to the repositories.
+    # Blender extracts the wheel matching its own Python next to the repositories.
     site = Path(os.environ["BLENDER_USER_RESOURCES"]) / "extensions" / ".local"
-    assert list(site.rglob("OpenEXR.cpython-311-*.so")), f"no cp311 OpenEXR extracted under {site}"
+    tag = "cpython-{}{}".format(*sys.version_info[:2])
+    assert list(site.rglob(f"OpenEXR.{tag}-*.so")), f"no {tag} OpenEXR extracted under {site}"
 
 
 def registered() -> None:
@@ -110,7 +114,7 @@ def command_run(command: Callable[[list[str]], int], work: Path, hdri_path: Path
     check_outputs(out, hdri_path)
 
 
-def operator_run(blend: Path) -> None:
+def operator_run(blend: Path, hdri_path: Path) -> None:
     import bpy
 
     world_layer = importlib.import_module(f"{PACKAGE}.operators.world_layer")
@@ -119,12 +123,32 @@ def operator_run(blend: Path) -> None:
     settings = scene.dimred
     settings.target = bpy.data.objects["Box"]
     settings.quality = "draft"
-    bpy.ops.dimred.remove()
+    nodes_before = len(scene.world.node_tree.nodes)
+    bpy.ops.ed.undo_push(message="before removal")
+    # As the UI calls it: a script's operator call pushes an undo step only when asked to.
+    assert bpy.ops.dimred.remove('EXEC_DEFAULT', True) == {'FINISHED'}
     assert world_layer.has_layer(scene.world), "Remove did not add the world layer"
     difference = world_layer.image_rgb(world_layer.layer_image(scene.world))
     assert difference.shape == (32, 64, 3) and np.isfinite(difference).all()
+    assert np.abs(difference).max() > 0, "the difference is zero: nothing was removed"
     assert json.loads(settings.last_report)["seconds"]
-    bpy.ops.dimred.clear()
+
+    # What Cycles renders of the world from the probe centre is HDRI + difference.
+    edited = tiny_scene.read_exr(hdri_path) + difference
+    # The proxy room would hide the world from the camera: only camera rays skip it.
+    for obj in scene.objects:
+        obj.visible_camera = False
+    render = tiny_scene.render_world(64, 32, tiny_scene.CENTER, blend.parent / "world.exr")
+    np.testing.assert_allclose(render, edited, rtol=1e-4, atol=1e-4)
+
+    bpy.ops.ed.undo()
+    scene = bpy.context.scene
+    assert not world_layer.has_layer(scene.world), "undo did not restore the original world"
+    assert len(scene.world.node_tree.nodes) == nodes_before
+    bpy.ops.ed.redo()
+    scene = bpy.context.scene
+    assert world_layer.has_layer(scene.world), "redo did not bring the removal back"
+    assert bpy.ops.dimred.clear() == {'FINISHED'}
     assert not world_layer.has_layer(scene.world)
 
 
@@ -150,13 +174,13 @@ def main(argv: list[str]) -> int:
         return value
 
     try:
-        zip_path = Path(argv[0]).resolve() if argv else step("build the zip with 4.2's blender_ext", build_zip, work)
+        zip_path = Path(argv[0]).resolve() if argv else step("build the zip with this Blender's blender_ext", build_zip, work)
         step("install and enable the zip", install, zip_path)
         step("operators and command registered", registered)
         command = step("blender_command importable from the installed package", command_function)
         blend, hdri_path = step("tiny scene opened", open_tiny_scene, work)
         step("blender -c dimred remove: files written and finite", command_run, command, work, hdri_path)
-        step("bpy.ops.dimred.remove and clear", operator_run, blend)
+        step("bpy.ops.dimred.remove, Cycles render of the world, undo, redo, clear", operator_run, blend, hdri_path)
     except Exception:
         pass  # step() printed it; every later step depends on this one
     if failed:

@@ -1,0 +1,338 @@
+"""One Remove run inside Blender: gather on the main thread, compute, show, apply or roll back.
+
+`RemovalSession.begin` reads everything the engine needs from Blender (plain arrays, never a
+bpy object, go to the engine). `run_here` computes on the calling thread (background mode,
+scripts); `start` hands the work to a `Worker` thread and `tick`, called from a modal
+operator's timer, shows progress and previews and applies the result when it arrives. Every
+step that touches bpy runs on the main thread and is short: files are decoded and written by
+the worker, and the main thread only renames them into place and points images at them.
+
+Running sessions are kept in `_running` so that file load, unregister and Blender's exit can
+stop and join their threads (the one piece of module state; Blender cannot do it for us).
+"""
+from __future__ import annotations
+
+import atexit
+import json
+import os
+import shutil
+import tempfile
+import time
+from dataclasses import dataclass, field
+
+import bpy
+import numpy as np
+
+from ..addon.errors import Cancelled, DimredError
+from ..addon.worker import Worker
+from . import world_layer
+
+PREVIEW_IMAGE = "DimRed Preview"
+# Seconds a cancelled worker may take to notice; the engine checks far more often than this.
+STOP_TIMEOUT = 5.0
+
+_running: list["RemovalSession"] = []
+
+
+def output_folder(settings: bpy.types.PropertyGroup) -> str:
+    """The absolute output folder; a '//' path needs a saved .blend to be relative to."""
+    raw = settings.output_dir.strip() or "//"
+    if raw.startswith("//") and not bpy.data.filepath:
+        raise DimredError(
+            f"The output folder '{raw}' is relative to the .blend file, which is not saved yet: "
+            "save it first, choose an absolute folder, or pack the result into the file"
+        )
+    return os.path.normpath(bpy.path.abspath(raw))
+
+
+def layer_filename(world: bpy.types.World) -> str:
+    """One layer file per world, so scenes sharing an output folder do not collide."""
+    return f"{bpy.path.clean_name(world.name)}_difference.exr"
+
+
+def own_filename(world: bpy.types.World, object_name: str) -> str:
+    return f"{bpy.path.clean_name(world.name)}_{bpy.path.clean_name(object_name)}_difference.exr"
+
+
+def probe_center(settings: bpy.types.PropertyGroup) -> tuple[float, float, float] | None:
+    # None lets the bridge apply the contract's fallbacks (an Empty named ProbeCenter, the origin).
+    return tuple(settings.probe_center) if settings.use_probe_center else None
+
+
+def active() -> "RemovalSession | None":
+    """The session that is computing now, if any."""
+    return next((s for s in _running if s.worker is not None and not s.done), None)
+
+
+def stop_all() -> None:
+    """Cancel and join every running worker (file load, unregister, exit)."""
+    for session in list(_running):
+        session.stop()
+
+
+@bpy.app.handlers.persistent
+def _stop_on_load(*_args) -> None:
+    stop_all()
+
+
+atexit.register(stop_all)
+
+
+def register() -> None:
+    if _stop_on_load not in bpy.app.handlers.load_pre:
+        bpy.app.handlers.load_pre.append(_stop_on_load)
+
+
+def unregister() -> None:
+    stop_all()
+    if _stop_on_load in bpy.app.handlers.load_pre:
+        bpy.app.handlers.load_pre.remove(_stop_on_load)
+
+
+@dataclass
+class RemovalSession:
+    scene_name: str
+    world_name: str
+    object_name: str
+    request: object  # addon.removal_job.RemovalRequest
+    pack: bool
+    relative: bool  # the output folder is given relative to the .blend
+    temporary_folder: str = ""
+    previous_layer: str = ""  # the image the world showed before, restored on cancel
+    worker: Worker | None = None
+    done: bool = False
+    stage: str = "starting"
+    fraction: float = 0.0
+    message: str = ""  # the result's one line (info or error)
+    ok: bool = False
+    report: dict = field(default_factory=dict)
+    warnings: list[str] = field(default_factory=list)  # about the removal order, added to the report
+    tick_seconds: list[float] = field(default_factory=list)  # main-thread time per tick
+
+    # -- main thread: gather ------------------------------------------------------------
+    @classmethod
+    def begin(cls, context: bpy.types.Context) -> "RemovalSession":
+        """Check the input and read the scene; DimredError says what is wrong (nothing changed)."""
+        from ..addon import bridge
+        from ..addon.removal_job import RemovalRequest
+
+        if active() is not None:
+            raise DimredError("A removal is already running: wait for it or cancel it")
+        scene = context.scene
+        settings, world = scene.dimred, scene.world
+        if world is None:
+            raise DimredError("The scene has no World: light it with the panorama first")
+        if settings.target is None:
+            raise DimredError("Mark the object to remove first")
+        target = settings.target.name
+        pack = settings.storage == 'PACK'
+        folder = "" if pack else output_folder(settings)
+        world_layer.world_nodes(world)  # refuses a world the layer cannot be added to, before the work
+        if pack:
+            folder = tempfile.mkdtemp(prefix="dimred-")
+        try:
+            bridge.check_object(scene, target)
+            names = settings.surface_names()
+            for name in names:
+                bridge.check_object(scene, name, purpose="used as a target surface")
+            earlier = [r for r in settings.removals if r.object_name != target and r.image is not None]
+            scene_data = bridge.read_scene(scene, probe_center(settings),
+                                           exclude=[r.object_name for r in earlier], defer_file=True)
+            # Its shape is checked against the panorama's in the worker, where the panorama is read.
+            base = _sum_images([r.image for r in earlier])
+            request = RemovalRequest(
+                scene=scene_data, object_name=target, planes=names, quality=settings.quality, base=base,
+                own_path=os.path.join(folder, own_filename(world, target)),
+                layer_path=os.path.join(folder, layer_filename(world)),
+            )
+        except BaseException:
+            if pack:
+                shutil.rmtree(folder, ignore_errors=True)
+            raise
+        previous = world_layer.layer_image(world) if world_layer.has_layer(world) else None
+        index = _index(settings, target)
+        later = [r.object_name for r in settings.removals[index + 1:]] if index >= 0 else []
+        warnings = [f"'{', '.join(later)}' were removed after '{target}' with it still in place: "
+                    "remove them again for the most accurate result"] if later else []
+        return cls(scene_name=scene.name, world_name=world.name, object_name=target, request=request, pack=pack,
+                   relative=settings.output_dir.strip().startswith("//") and not pack,
+                   temporary_folder=folder if pack else "",
+                   previous_layer=previous.name if previous is not None else "", warnings=warnings)
+
+    # -- computing ------------------------------------------------------------------------
+    def run_here(self, context: bpy.types.Context) -> bool:
+        """Compute on this thread and apply; True on success (`message` says what happened)."""
+        from ..addon.removal_job import run
+
+        try:
+            outcome = run(self.request)
+        except DimredError as error:
+            return self._fail(context, str(error))
+        return self._apply(context, outcome)
+
+    def start(self) -> None:
+        """Compute in a worker thread; `tick` polls it."""
+        from ..addon.removal_job import run
+
+        request = self.request
+        self.worker = Worker(lambda progress, cancelled, preview: run(request, progress, cancelled, preview)).start()
+        _running.append(self)
+
+    def tick(self, context: bpy.types.Context) -> str:
+        """Poll the worker: 'RUNNING', 'FINISHED' or 'CANCELLED' (failed or cancelled)."""
+        started = time.perf_counter()
+        try:
+            update = self.worker.poll()
+            self.stage, self.fraction = update.stage, update.fraction
+            if update.preview is not None and not self.worker.cancelled:
+                self._show_preview(context, update.preview)
+            if not update.finished:
+                return 'RUNNING'
+            self.done = True
+            self._forget()
+            if isinstance(update.error, DimredError):
+                self._fail(context, str(update.error))
+            elif update.error is not None:
+                self._fail(context, f"The removal failed: {type(update.error).__name__}: {update.error}")
+            else:
+                self._apply(context, update.result)
+            return 'FINISHED' if self.ok else 'CANCELLED'
+        finally:
+            self.tick_seconds.append(time.perf_counter() - started)
+
+    def cancel(self, context: bpy.types.Context | None = None) -> None:
+        """Stop the worker, wait for it, and put the world back as it was."""
+        self.stop()
+        if not self.done:
+            self.done = True
+            self._fail(context, str(Cancelled()))
+
+    def stop(self) -> None:
+        if self.worker is not None:
+            self.worker.stop(STOP_TIMEOUT)
+        self._forget()
+
+    # -- main thread: show and apply ----------------------------------------------------------
+    def _world(self) -> bpy.types.World | None:
+        return bpy.data.worlds.get(self.world_name)
+
+    def _show_preview(self, context: bpy.types.Context, pixels: np.ndarray) -> None:
+        world = self._world()
+        if world is None:
+            return
+        image = bpy.data.images.get(PREVIEW_IMAGE)
+        size = _image_size(world)
+        if image is not None and tuple(image.size) != size:
+            bpy.data.images.remove(image)
+            image = None
+        if image is None:
+            image = bpy.data.images.new(PREVIEW_IMAGE, size[0], size[1], alpha=True, float_buffer=True)
+            image.colorspace_settings.name = world_layer.DIFFERENCE_COLORSPACE
+        if len(pixels) != size[0] * size[1] * 4:
+            return
+        image.pixels.foreach_set(pixels)
+        image.update()
+        if world_layer.layer_image(world) is not image:
+            world_layer.add_layer(world, image)
+        world.update_tag()
+        _redraw(context)
+
+    def _apply(self, context: bpy.types.Context, outcome) -> bool:
+        world = self._world()
+        scene = bpy.data.scenes.get(self.scene_name)
+        if world is None or scene is None:
+            outcome.staged.discard()
+            return self._fail(context, "The scene or world was deleted while the removal ran")
+        try:
+            outcome.staged.commit()
+        except OSError as error:
+            outcome.staged.discard()
+            return self._fail(context, f"Could not write the difference image: {error}")
+        request = self.request
+        own = _load(request.own_path, os.path.basename(request.own_path)[:-4], self.relative, self.pack)
+        layer = _load(request.layer_path, os.path.basename(request.layer_path)[:-4], self.relative, self.pack)
+        if self.pack:
+            shutil.rmtree(self.temporary_folder, ignore_errors=True)
+        _drop_preview()
+        world_layer.add_layer(world, layer)
+        settings = scene.dimred
+        index = _index(settings, self.object_name)
+        entry = settings.removals[index] if index >= 0 else settings.removals.add()
+        entry.object_name, entry.image = self.object_name, own
+        report = dict(outcome.report)
+        report.setdefault("warnings", []).extend(self.warnings)
+        report["layer"] = [r.object_name for r in settings.removals]
+        settings.last_report = json.dumps(report)
+        self.report, self.ok = report, True
+        where = "packed into the .blend" if self.pack else f"wrote {request.layer_path}"
+        self.message = f"Removed '{self.object_name}': {report_summary(report)}; {where}"
+        _redraw(context)
+        return True
+
+    def _fail(self, context: bpy.types.Context | None, message: str) -> bool:
+        """Put the world back as it was before this session and keep `message`."""
+        world = self._world()
+        if world is not None and world_layer.layer_image(world) is not None \
+                and world_layer.layer_image(world).name == PREVIEW_IMAGE:
+            previous = bpy.data.images.get(self.previous_layer) if self.previous_layer else None
+            if previous is not None:
+                world_layer.add_layer(world, previous)
+            else:
+                world_layer.remove_layer(world)
+        _drop_preview()
+        if self.temporary_folder:
+            shutil.rmtree(self.temporary_folder, ignore_errors=True)
+        self.ok, self.message = False, message
+        if context is not None:
+            _redraw(context)
+        return False
+
+    def _forget(self) -> None:
+        if self in _running:
+            _running.remove(self)
+
+
+def report_summary(report: dict) -> str:
+    """One line about a run's report dict (fields per the command line's report.json)."""
+    total = report.get("seconds", {}).get("total")
+    parts = [f"{total:.1f} s" if isinstance(total, (int, float)) else "done"]
+    for key, label in (("skipped", "stages skipped"), ("warnings", "warnings")):
+        if report.get(key):
+            parts.append(f"{len(report[key])} {label}")
+    return ", ".join(parts)
+
+
+def _index(settings: bpy.types.PropertyGroup, object_name: str) -> int:
+    return next((i for i, r in enumerate(settings.removals) if r.object_name == object_name), -1)
+
+
+def _sum_images(images: list[bpy.types.Image]) -> np.ndarray | None:
+    if not images:
+        return None
+    return np.sum([world_layer.image_rgb(image) for image in images], axis=0, dtype=np.float32)
+
+
+def _image_size(world: bpy.types.World) -> tuple[int, int]:
+    original, _ = world_layer.world_nodes(world)
+    return tuple(original.image.size)
+
+
+def _load(path: str, name: str, relative: bool, pack: bool) -> bpy.types.Image:
+    # A folder given relative to the .blend stays relative, so the file can move with it.
+    image = world_layer.load_difference_image(bpy.path.relpath(path) if relative else path, name)
+    if pack:
+        image.pack()
+    return image
+
+
+def _drop_preview() -> None:
+    image = bpy.data.images.get(PREVIEW_IMAGE)
+    if image is not None:
+        bpy.data.images.remove(image)
+
+
+def _redraw(context: bpy.types.Context | None) -> None:
+    screen = getattr(context, "screen", None) if context is not None else None
+    for area in (screen.areas if screen is not None else ()):
+        if area.type in {'VIEW_3D', 'PROPERTIES', 'NODE_EDITOR', 'IMAGE_EDITOR'}:
+            area.tag_redraw()
