@@ -32,6 +32,7 @@ class RemovalRequest:
     base: np.ndarray | None = None  # (H, W, 3) difference of the objects removed before
     own_path: str = ""  # where this removal's own difference goes
     layer_path: str = ""  # where base + own difference (what the world shows) goes
+    overrides: dict = field(default_factory=dict)  # engine parameters that replace the preset's
 
 
 @dataclass
@@ -96,7 +97,8 @@ def run(
         scene = replace(scene, hdri=(scene.hdri + base).astype(np.float32))
     show = None if preview is None else (
         lambda difference: preview(blender_pixels(difference if base is None else difference + base)))
-    result = remove_object(scene, request.object_name, request.planes, request.quality, progress, cancel, preview=show)
+    result = remove_object(scene, request.object_name, request.planes, request.quality, progress, cancel,
+                           preview=show, **request.overrides)
     layer = result.difference if base is None else (result.difference + base).astype(np.float32)
     if cancel is not None and cancel():
         raise Cancelled()

@@ -143,7 +143,7 @@ class RemovalSession:
             request = RemovalRequest(
                 scene=scene_data, object_name=target, planes=names, quality=settings.quality, base=base,
                 own_path=os.path.join(folder, own_filename(world, target)),
-                layer_path=os.path.join(folder, layer_filename(world)),
+                layer_path=os.path.join(folder, layer_filename(world)), overrides=settings.overrides(),
             )
         except BaseException:
             if pack:

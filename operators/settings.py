@@ -6,7 +6,9 @@ from bpy.props import (
     BoolProperty,
     CollectionProperty,
     EnumProperty,
+    FloatProperty,
     FloatVectorProperty,
+    IntProperty,
     PointerProperty,
     StringProperty,
 )
@@ -16,6 +18,11 @@ QUALITY_ITEMS = (
     ("balanced", "Balanced", "The default trade-off between run time and accuracy, as on the command line"),
     ("final", "Final", "Most patches, light senders and bounces: slowest, most accurate"),
 )
+
+
+# Settings that override the preset's engine parameter of the same name (addon.quality.Params).
+OVERRIDABLE = ("patches", "max_senders", "max_bounces", "raster_cell", "synth_neighbourhood",
+               "synth_generations", "seed")
 
 
 def _is_mesh(_settings: bpy.types.PropertyGroup, obj: bpy.types.Object) -> bool:
@@ -73,6 +80,43 @@ class DimredSettings(bpy.types.PropertyGroup):
         subtype='DIR_PATH',
         default="//dimred/",
     )
+    override_parameters: BoolProperty(
+        name="Override Preset",
+        description="Use the parameters below instead of the quality preset's",
+    )
+    patches: IntProperty(
+        name="Patches", min=20, soft_max=5000, default=500,
+        description="Radiosity patches on the room: more resolve the light's change on walls and floor "
+                    "more finely, and cost time in proportion",
+    )
+    max_senders: IntProperty(
+        name="Light Senders", min=1, soft_max=256, default=32,
+        description="Most bright patches (lamps, sunlit areas) whose shadows are traced exactly: more catch "
+                    "faint secondary shadows, each one costs a visibility pass",
+    )
+    max_bounces: IntProperty(
+        name="Bounces", min=0, soft_max=32, default=8,
+        description="How many times the change of light is passed around the room: more remove the "
+                    "object's colour bleeding further away, each costs a transport step",
+    )
+    raster_cell: FloatProperty(
+        name="Fill Cell", min=0.2, soft_max=3.0, default=0.7,
+        description="Cell of the plane raster the fill is synthesised on, in panorama pixels: smaller keeps "
+                    "finer texture, larger is faster",
+    )
+    synth_neighbourhood: IntProperty(
+        name="Neighbourhood", min=3, soft_max=15, default=7,
+        description="Synthesis window in cells (odd): larger continues larger structures such as tile lines, "
+                    "slower",
+    )
+    synth_generations: IntProperty(
+        name="Generations", min=1, soft_max=6, default=2,
+        description="Synthesis passes per pyramid level: more settle the seams, slower",
+    )
+    seed: IntProperty(
+        name="Seed", min=0, default=0,
+        description="Random seed of the fill: the same seed gives the same result, another seed another fill",
+    )
     storage: EnumProperty(
         name="Store Result",
         items=(
@@ -92,6 +136,12 @@ class DimredSettings(bpy.types.PropertyGroup):
         description="The last removal's report, as JSON",
         options={'HIDDEN'},
     )
+
+    def overrides(self) -> dict[str, float | int]:
+        """The engine parameters set here, when they override the preset (else none)."""
+        if not self.override_parameters:
+            return {}
+        return {name: getattr(self, name) for name in OVERRIDABLE}
 
     def surface_names(self) -> tuple[str, ...]:
         """Names of the marked surfaces that still exist."""

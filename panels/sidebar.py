@@ -6,6 +6,7 @@ import json
 import bpy
 
 from ..operators import session, world_layer
+from ..operators.settings import OVERRIDABLE
 
 CATEGORY = "Diminished Reality"
 
@@ -71,6 +72,25 @@ class DIMRED_PT_main(bpy.types.Panel):
                 column.label(text=entry.object_name, icon='GHOST_ENABLED')
 
 
+class DIMRED_PT_parameters(bpy.types.Panel):
+    bl_label = "Parameters"
+    bl_idname = "DIMRED_PT_parameters"
+    bl_space_type = 'VIEW_3D'
+    bl_region_type = 'UI'
+    bl_category = CATEGORY
+    bl_parent_id = "DIMRED_PT_main"
+    bl_options = {'DEFAULT_CLOSED'}
+
+    def draw(self, context: bpy.types.Context) -> None:
+        layout = self.layout
+        settings = context.scene.dimred
+        layout.prop(settings, "override_parameters")
+        column = layout.column(align=True)
+        column.enabled = settings.override_parameters
+        for name in OVERRIDABLE:
+            column.prop(settings, name)
+
+
 class DIMRED_PT_last_run(bpy.types.Panel):
     bl_label = "Last Run"
     bl_idname = "DIMRED_PT_last_run"
@@ -124,6 +144,6 @@ def _text(value: object) -> str:
     return str(value)
 
 
-classes = (DIMRED_PT_main, DIMRED_PT_last_run)
+classes = (DIMRED_PT_main, DIMRED_PT_parameters, DIMRED_PT_last_run)
 
 register, unregister = bpy.utils.register_classes_factory(classes)

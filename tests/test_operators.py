@@ -244,3 +244,20 @@ def test_the_result_survives_saving_and_reopening(room, tmp_path, extension, sto
     assert world_layer.has_layer(world)
     np.testing.assert_array_equal(world_layer.image_rgb(world_layer.layer_image(world)), shown)
     assert [r.object_name for r in bpy.context.scene.dimred.removals] == ["Box"]
+
+
+def test_parameter_overrides_reach_the_engine(room, extension):
+    from diminished_reality.addon.quality import PRESETS
+    from diminished_reality.operators.settings import OVERRIDABLE
+
+    settings = bpy.context.scene.dimred
+    # Untouched, the panel's values are the balanced preset's, so ticking Override changes nothing.
+    assert {n: getattr(settings, n) for n in OVERRIDABLE} == pytest.approx(
+        {n: getattr(PRESETS["balanced"], n) for n in OVERRIDABLE})
+    assert bpy.ops.dimred.remove() == {'FINISHED'}
+    assert json.loads(settings.last_report)["parameters"]["patches"] == PRESETS["draft"].patches
+    settings.override_parameters = True
+    settings.patches, settings.seed = 123, 7
+    assert bpy.ops.dimred.remove() == {'FINISHED'}
+    used = json.loads(settings.last_report)["parameters"]
+    assert used["patches"] == 123 and used["seed"] == 7

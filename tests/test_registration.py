@@ -234,6 +234,7 @@ def test_panels_draw_existing_properties_operators_and_icons(registered, monkeyp
         ' "warnings": ["hidden region not filled"], "guards": {"reflectance_clamped_patches": 3}}'
     )
     assert sidebar.DIMRED_PT_last_run.poll(bpy.context)
+    assert "prop override_parameters" in _draw(sidebar.DIMRED_PT_parameters, bpy.context)
     drawn = _draw(sidebar.DIMRED_PT_last_run, bpy.context)
     for line in ("label total: 2.00 s", "label Skipped synthesis: not yet", "label hidden region not filled",
                  "label reflectance_clamped_patches: 3"):
