@@ -1,0 +1,148 @@
+"""Error against run time: the removal over a sweep of the parameters that trade one for the other.
+
+For each setting (the three presets, then the balanced preset with one parameter changed at a
+time) the removal runs on the cached ground-truth scenes; the script measures the lighting error
+ratio against the Cycles truth (region A, `scenes.metrics.lighting_error_ratio`) and its Monte
+Carlo noise floor (`noise_floor`: the error left when the input is scaled by the 3x3 box-filtered
+ratio of truth to input), the hidden region's scores, and the seconds of the lighting stages and
+of the synthesis. The panorama resolution is swept on the 0.5 m box (256x128 and 1024x512).
+It writes `out/tradeoff/tradeoff.csv` and `tradeoff.md` (a row per setting, means over the
+scenes, the Pareto front of error against total seconds marked) and prints the Markdown;
+`benchmarks/plot_tradeoff.py` draws the plot from the CSV.
+"""
+from __future__ import annotations
+
+import csv
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from rendered import arguments, open_scene  # noqa: E402
+from scenes import metrics as M  # noqa: E402
+
+SCENES = ("basic_box", "red_box", "wall_contact", "stool")
+# (label, preset, overrides): each sweep changes one parameter of the balanced preset.
+SETTINGS = (
+    ("draft", "draft", {}),
+    ("balanced", "balanced", {}),
+    ("final", "final", {}),
+    ("patches=200", "balanced", {"patches": 200}),
+    ("patches=1200", "balanced", {"patches": 1200}),
+    ("max_senders=8", "balanced", {"max_senders": 8}),
+    ("max_senders=64", "balanced", {"max_senders": 64}),
+    ("sender_samples=2", "balanced", {"sender_samples": 2}),
+    ("sender_samples=6", "balanced", {"sender_samples": 6}),
+    ("fine_cells=2", "balanced", {"fine_cells": 2.0}),
+    ("fine_cells=5", "balanced", {"fine_cells": 5.0}),
+    ("significance=0.03", "balanced", {"significance": 0.03}),
+    ("significance=0.003", "balanced", {"significance": 0.003}),
+    ("max_bounces=2", "balanced", {"max_bounces": 2}),
+    ("raster_cell=1.4", "balanced", {"raster_cell": 1.4}),
+    ("raster_cell=0.5", "balanced", {"raster_cell": 0.5}),
+    ("synth_levels=2", "balanced", {"synth_levels": 2}),
+    ("synth_generations=1", "balanced", {"synth_generations": 1}),
+    ("synth_generations=3", "balanced", {"synth_generations": 3}),
+    ("synth_neighbourhood=5", "balanced", {"synth_neighbourhood": 5}),
+    ("synth_neighbourhood=9", "balanced", {"synth_neighbourhood": 9}),
+)
+RESOLUTION_SETTINGS = ("draft", "balanced")
+FIELDS = ("setting", "scenes", "width", "lighting_ratio", "noise_floor", "ratio_over_floor", "hidden_mean",
+          "hidden_detail", "object_shadow", "lighting_s", "synthesis_s", "total_s", "pareto")
+
+
+def _measure(scene_name: str, width: int, samples: int, settings) -> list[dict]:
+    """Rows of one scene: every setting's scores and seconds."""
+    import bpy
+
+    from addon import bridge
+    from addon.pipeline import remove_object
+    from scenes.images import read_exr
+
+    args = arguments("").parse_args(["--scene", scene_name, "--width", str(width), "--samples", str(samples)])
+    spec, paths = open_scene(args)
+    scene = bridge.read_scene(bpy.context.scene)
+    inp, truth, mask = read_exr(paths["input"]), read_exr(paths["truth"]), np.load(paths["mask"])
+    floor = M.noise_floor(inp, truth, mask)
+    rows = []
+    for label, preset, overrides in settings:
+        t0 = time.perf_counter()
+        result = remove_object(scene, spec.remove, quality=preset, **overrides)
+        total = time.perf_counter() - t0
+        seconds = result.report["seconds"]
+        hidden = M.hidden_region_scores(inp, result.edited, truth, mask)
+        synthesis = seconds.get("synthesis", 0.0)
+        rows.append(dict(setting=label, scenes=scene_name, width=width,
+                         lighting_ratio=M.lighting_error_ratio(inp, result.edited, truth, mask), noise_floor=floor,
+                         hidden_mean=hidden["mean_ratio"], hidden_detail=hidden["detail_ratio"],
+                         object_shadow=hidden["object_shadow_ratio"], lighting_s=total - synthesis,
+                         synthesis_s=synthesis, total_s=total))
+        print(f"  {scene_name} {width}: {label}: ratio {rows[-1]['lighting_ratio']:.3f}, {total:.1f} s", flush=True)
+    return rows
+
+
+def _mean_rows(rows: list[dict], width: int) -> list[dict]:
+    """One row per setting: means over the scenes measured at `width`."""
+    out = []
+    labels = list(dict.fromkeys(r["setting"] for r in rows if r["width"] == width))
+    for label in labels:
+        group = [r for r in rows if r["setting"] == label and r["width"] == width]
+        row = {k: float(np.mean([r[k] for r in group])) for k in FIELDS[3:-1] if k != "ratio_over_floor"}
+        row["ratio_over_floor"] = row["lighting_ratio"] / row["noise_floor"]
+        out.append(dict(setting=label, scenes="+".join(r["scenes"] for r in group), width=width, **row))
+    return out
+
+
+def pareto(rows: list[dict], cost: str = "total_s", error: str = "lighting_ratio") -> None:
+    """Mark the rows no other row beats in both `cost` and `error` (row["pareto"])."""
+    for row in rows:
+        row["pareto"] = not any(o[cost] <= row[cost] and o[error] <= row[error]
+                                and (o[cost] < row[cost] or o[error] < row[error]) for o in rows)
+
+
+def markdown(rows: list[dict]) -> str:
+    head = ("| setting | width | lighting error ratio | noise floor | ratio / floor | hidden mean | hidden detail "
+            "| object + shadow | lighting s | synthesis s | total s | Pareto |")
+    lines = [head, "|---" * 12 + "|"]
+    for r in rows:
+        lines.append(f"| {r['setting']} | {r['width']} | {r['lighting_ratio']:.3f} | {r['noise_floor']:.3f} | "
+                     f"{r['ratio_over_floor']:.2f} | {r['hidden_mean']:.3f} | {r['hidden_detail']:.2f} | "
+                     f"{r['object_shadow']:.3f} | {r['lighting_s']:.2f} | {r['synthesis_s']:.2f} | "
+                     f"{r['total_s']:.2f} | {'yes' if r['pareto'] else ''} |")
+    return "\n".join(lines)
+
+
+def main() -> None:
+    ap = arguments(__doc__)
+    ap.add_argument("--out", default="out/tradeoff")
+    ap.add_argument("--scenes", default=",".join(SCENES))
+    args = ap.parse_args()
+    started = time.perf_counter()
+    rows: list[dict] = []
+    for name in args.scenes.split(","):
+        rows += _measure(name, 256, 64, SETTINGS)
+    table = _mean_rows(rows, 256)
+    pareto(table)
+    big = [s for s in SETTINGS if s[0] in RESOLUTION_SETTINGS]
+    wide = _measure("basic_box", 1024, 16, big)
+    for row in wide:
+        row["ratio_over_floor"] = row["lighting_ratio"] / row["noise_floor"]
+        row["pareto"] = False
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    with open(out / "tradeoff.csv", "w", newline="") as handle:
+        writer = csv.DictWriter(handle, FIELDS)
+        writer.writeheader()
+        for row in table + wide:
+            writer.writerow({k: (f"{v:.4f}" if isinstance(v, float) else v) for k, v in row.items()})
+    text = (f"Means over {args.scenes} at 256x128 (64 spp), then the 0.5 m box at 1024x512 (16 spp); "
+            f"{time.perf_counter() - started:.0f} s in all.\n\n" + markdown(table + wide) + "\n")
+    (out / "tradeoff.md").write_text(text)
+    print(text)
+
+
+if __name__ == "__main__":
+    main()
