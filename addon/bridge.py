@@ -48,6 +48,9 @@ def read_scene(scene: bpy.types.Scene, center: Sequence[float] | None = None,
     keeps Blender's main thread free of the file's decoding.
     """
     notes: list[str] = []
+    # Transforms set since the last update (a script that just placed the probe Empty) are not
+    # in matrix_world yet; evaluate the view layer first.
+    _view_layer(scene).update()
     node = environment_texture(scene)
     rotation = texture_rotation(node)
     hdri, path = _panorama(node.image, notes, defer_file)
@@ -399,7 +402,6 @@ def _geometry(scene: bpy.types.Scene, notes: list[str],
     visible = sorted((obj for obj in _render_visible_objects(scene) if obj.name not in exclude),
                      key=lambda obj: obj.name)
     depsgraph = _view_layer(scene).depsgraph
-    depsgraph.update()
     names: list[str] = []
     chunks: list[np.ndarray] = []
     owners: list[np.ndarray] = []

@@ -88,7 +88,9 @@ def build_geometry(
     cr = np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0])
     twice_area = np.linalg.norm(cr, axis=1)
     scale = float(np.linalg.norm(tris.reshape(-1, 3).max(axis=0) - tris.reshape(-1, 3).min(axis=0)))
-    keep = twice_area > 1e-10 * max(scale, 1e-9) ** 2
+    # Below (1e-4 of the scene's size)^2 a triangle covers far less than a pixel of any panorama
+    # and carries no light worth a patch; slivers of that area would only unsettle the patches.
+    keep = twice_area > 1e-8 * max(scale, 1e-9) ** 2
     tris, cr, twice_area = tris[keep], cr[keep], twice_area[keep]
     tri_object = np.asarray(tri_object)[keep]
     normals = cr / twice_area[:, None]

@@ -4,6 +4,7 @@ The command line, the Blender operators and the tests all call `remove_object`.
 """
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Callable, Sequence
 
 import numpy as np
@@ -46,7 +47,16 @@ def remove_object(
     `preview(difference)` gets coarse difference images before the result (see `removal.remove`)."""
     validate(scene)
     params = params_for(quality, **overrides)
+    # Negative radiance is not light (a bad merge or a denoiser's ringing): the engine reads it
+    # as black, and those pixels are passed through as they are.
+    negative = int((scene.hdri < 0).any(axis=2).sum())
+    original = scene.hdri
+    if negative:
+        scene = replace(scene, hdri=np.maximum(scene.hdri, 0.0))
     result = remove(scene, object_name, list(planes), params, progress, cancel, preview)
+    result.report["guards"]["negative_input_pixels_clamped"] = negative
+    if negative:
+        result.edited = (original + result.difference).astype(np.float32)
     result.report["quality"] = quality
     result.report["parameters"] = {k: getattr(params, k) for k in params.__dataclass_fields__}
     result.report["image_size"] = [int(scene.hdri.shape[1]), int(scene.hdri.shape[0])]

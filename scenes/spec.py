@@ -93,7 +93,7 @@ class Render:
     height: int = 128
     samples: int = 64
     seed: int = 1
-    max_bounces: int = 8
+    max_bounces: int = 64  # a photograph holds every bounce; 8 hid most of the change in a white room
 
 
 @dataclass(frozen=True)
@@ -339,6 +339,82 @@ def _second_object() -> SceneSpec:
     )
 
 
+def _tiny_lamp() -> SceneSpec:
+    room = Room(lo=(-2.0, -2.4, 0.0), hi=(2.6, 2.0, 2.5),
+                floor=Floor("checker", (0.5, 0.48, 0.45), (0.28, 0.27, 0.25), 0.35))
+    # A 6 cm lamp with 10^4 times the radiance of the other: a hard shadow from a near point light.
+    return SceneSpec(
+        name="tiny_lamp",
+        room=room,
+        lamps=(Lamp((0.9, -1.3), (0.06, 0.06), 1.5e5), Lamp((-1.2, 1.1), (0.7, 0.7), 15.0)),
+        objects=(SceneObject("Box", "box", (0.4, 0.35, 0.45), _on_floor(room, 1.0, -0.7),
+                             (0.6, 0.5, 0.4), rotation_z=-15.0),),
+        probe=(-0.2, 0.1, 1.4),
+        remove="Box",
+    )
+
+
+def _dark_floor() -> SceneSpec:
+    room = Room(lo=(-2.4, -2.0, 0.0), hi=(2.4, 2.2, 2.7), wall_albedo=(0.6, 0.6, 0.58),
+                floor=Floor("noise", (0.02, 0.02, 0.02), (0.05, 0.045, 0.04), 0.2))
+    # Reflectance near 0: the floor's radiance is a few percent of the walls'.
+    return SceneSpec(
+        name="dark_floor",
+        room=room,
+        lamps=(Lamp((-0.8, 1.2), (0.5, 0.5), 30.0), Lamp((1.4, -0.8), (0.4, 0.4), 25.0)),
+        objects=(SceneObject("Box", "box", (0.5, 0.4, 0.55), _on_floor(room, -0.9, 1.0),
+                             (0.7, 0.7, 0.7), rotation_z=30.0),),
+        probe=(0.2, 0.0, 1.5),
+        remove="Box",
+    )
+
+
+def _white_floor() -> SceneSpec:
+    room = Room(lo=(-2.2, -2.6, 0.0), hi=(2.4, 1.8, 2.6), wall_albedo=(0.92, 0.92, 0.9),
+                ceiling_albedo=(0.95, 0.95, 0.95),
+                floor=Floor("planks", (0.95, 0.94, 0.9), (0.9, 0.88, 0.84), 0.25))
+    # Reflectance near 1 everywhere: many bounces, the propagation does most of the work.
+    return SceneSpec(
+        name="white_floor",
+        room=room,
+        lamps=(Lamp((0.6, 0.7), (0.4, 0.4), 20.0),),
+        objects=(SceneObject("Cylinder", "cylinder", (0.45, 0.45, 0.6), _on_floor(room, 0.9, -1.2),
+                             (0.3, 0.35, 0.7)),),
+        probe=(0.0, 0.0, 1.5),
+        remove="Cylinder",
+    )
+
+
+def _zenith() -> SceneSpec:
+    room = Room(lo=(-2.0, -2.0, 0.0), hi=(2.5, 2.2, 2.6),
+                floor=Floor("checker", (0.6, 0.6, 0.6), (0.35, 0.35, 0.35), 0.4))
+    # Hanging from the ceiling straight above the probe: the panorama's top rows.
+    return SceneSpec(
+        name="zenith",
+        room=room,
+        lamps=(Lamp((1.4, 1.2), (0.5, 0.5), 30.0), Lamp((-1.2, -1.0), (0.5, 0.5), 25.0)),
+        objects=(SceneObject("Shade", "box", (0.5, 0.5, 0.3), (0.05, 0.0, room.hi[2] - 0.3),
+                             (0.7, 0.6, 0.5), rotation_z=10.0),),
+        probe=(0.0, 0.0, 1.5),
+        remove="Shade",
+    )
+
+
+def _grazing() -> SceneSpec:
+    room = Room(lo=(-1.5, -1.8, 0.0), hi=(7.0, 1.8, 2.6), floor=_WOOD)
+    # The probe 25 cm above the floor of a long room: the floor is seen at grazing angles up to
+    # its horizon, the box's shadow at 10-20 degrees below it.
+    return SceneSpec(
+        name="grazing",
+        room=room,
+        lamps=(Lamp((1.6, 0.9), (0.5, 0.5), 30.0), Lamp((5.0, -0.6), (0.5, 0.5), 25.0)),
+        objects=(SceneObject("Box", "box", (0.45, 0.45, 0.4), _on_floor(room, 1.5, 0.35),
+                             (0.55, 0.5, 0.45), rotation_z=15.0),),
+        probe=(0.0, 0.0, 0.25),
+        remove="Box",
+    )
+
+
 def _demo() -> SceneSpec:
     room = Room(lo=(-2.5, -2.0, 0.0), hi=(3.0, 2.5, 2.8), wall_albedo=(0.78, 0.76, 0.72),
                 floor=_WOOD)
@@ -367,6 +443,11 @@ SPECS: dict[str, SceneSpec] = {s.name: s for s in (
     _nadir(),
     _basic_box("rotated_world", world_rotation_z=70.0),
     _second_object(),
+    _tiny_lamp(),
+    _dark_floor(),
+    _white_floor(),
+    _zenith(),
+    _grazing(),
     _demo(),
 )}
 

@@ -19,7 +19,8 @@ from scenes.render import REPO, load_pair, render_pair, render_world
 # 70 degrees of world rotation is exactly 14 columns at this width, so the rotated and the
 # plain panoramas are whole-pixel shifts of each other and can be compared bit for bit.
 W, H = 72, 36
-TINY = {"width": W, "height": H, "samples": 16}
+# Few bounces: these tests check the harness (files, seeding, masks), not the light transport.
+TINY = {"width": W, "height": H, "samples": 16, "max_bounces": 8}
 
 
 def _py(code: str) -> str:
