@@ -3,6 +3,8 @@
 Three scales work together:
   * coarse patches over the whole room: radiosity from the panorama, reflectance, estimates
     for what the probe cannot see, and the propagation of the change for several bounces;
+    the few patches whose light varies within them (under the object's contact, at its
+    shadow's edge) send through sub-triangles wherever pixels take their light;
   * a fine lattice near the object: the light of the many unimportant senders and of the
     object itself, interpolated to pixels (the thesis's coarse grid of corner samples);
   * each affected pixel's own 3D point and normal: the important senders (lamps) that the
@@ -22,7 +24,7 @@ from .errors import Cancelled, DimredError
 from .formfactor import paired_point_to_triangle
 from .geometry import Geometry, boundary_objects, build_geometry, plane_of_object, surface_keys
 from .hiddenfill import PanoramaMaps, fill_surface
-from .patches import Lattice, build_lattice, levels_for_count, levels_for_size, triangle_samples
+from .patches import Lattice, build_lattice, levels_for_count, levels_for_size, split_triangles, triangle_samples
 from .planner import neighbourhood, shadow_volume
 from .quality import Params
 from .radiosity import LUMA, RHO_MAX, fill_unseen, patch_radiosity, propagate, recover_reflectance
@@ -82,6 +84,46 @@ class _Room:
 
     def patch_mean(self, receiver_values: np.ndarray) -> np.ndarray:
         return receiver_values[self.patch_rows]
+
+
+@dataclass
+class _Split:
+    """Patches that send through sub-triangles wherever pixels take their light.
+
+    Near the object a patch's radiosity can vary within it: dark under the object and lit
+    beside it, or changed at one end by the removal and not at the other. Spread evenly over
+    the patch, it would light a receiver beside one end as if the other end's light were there
+    too. The patch then carries only the later bounces of the change, which are smooth."""
+
+    parent: np.ndarray  # (M,) patch of each sub-triangle
+    senders: Senders  # (M,) the sub-triangles, sampled at their centroids
+    b: np.ndarray  # (M, 3) radiosity as photographed
+    db: np.ndarray  # (M, 3) first change of radiosity after removal
+    areas: np.ndarray  # (M,)
+    t_with: np.ndarray | None = None  # (R, M) the coarse receivers' transport from them, set by the propagation
+    t_without: np.ndarray | None = None  # (R, M) likewise, without the object
+
+    @classmethod
+    def of(cls, room: _Room, groups: list[tuple[np.ndarray, int, np.ndarray, np.ndarray]]) -> "_Split":
+        """Patches split by groups (patch indices (n,), level k, the radiosity as photographed
+        and its first change at the centroids of their k^2 sub-triangles (each (n, k^2, 3)))."""
+        groups = [(np.zeros(0, dtype=np.int64), 1, np.zeros((0, 1, 3)), np.zeros((0, 1, 3)))] + groups
+        ptris = room.lattice.patch_triangles()
+        tris = np.concatenate([split_triangles(ptris[g[0]], g[1]).reshape(-1, 3, 3) for g in groups])
+        parent = np.concatenate([np.repeat(g[0], g[1] ** 2) for g in groups])
+        b = np.concatenate([g[2].reshape(-1, 3) for g in groups])
+        db = np.concatenate([g[3].reshape(-1, 3) for g in groups])
+        areas = np.concatenate([np.repeat(room.areas[g[0]], g[1] ** 2) / g[1] ** 2 for g in groups])
+        m = len(tris)
+        senders = make_senders(tris, room.senders.normals[parent], b, np.zeros(m, dtype=bool),
+                               [(np.arange(m), tris.mean(axis=1)[:, None, :])])
+        return cls(parent, senders, b, db, areas)
+
+    def rest(self, b: np.ndarray) -> np.ndarray:
+        """(P, 3) patch radiosities b less what the split patches send through their sub-triangles."""
+        out = b.copy()
+        out[self.parent] = 0.0
+        return out
 
 
 class _Removal:
@@ -265,8 +307,9 @@ class _Removal:
         past_object, seen = (v.reshape(len(idx), k * k, 1) for v in self._seen(pts))
         return pts, nrm, tw, two, past_object, seen
 
-    def first_order_patches(self, room: _Room) -> np.ndarray:
-        """(P, 3) first-order change of irradiance, averaged over each patch.
+    def first_order_patches(self, room: _Room) -> tuple[np.ndarray, _Split]:
+        """(P, 3) first-order change of irradiance, averaged over each patch, and the split of
+        those whose light varies within them (see `_split`).
 
         Patches near the object are sampled at k^2 points, and the samples the probe cannot see
         correct what the pixels alone got wrong for a patch partly under or behind the object:
@@ -286,7 +329,7 @@ class _Removal:
         refine = np.flatnonzero(near & ~room.senders.on_removed & ~room.emitter)
         self.rep.info["refined_patches"] = int(len(refine))
         if not len(refine):
-            return room.patch_mean((room.t_without - room.t_with) @ b)
+            return room.patch_mean((room.t_without - room.t_with) @ b), _Split.of(room, [])
         pts, nrm, tw, two, past_object, seen = self._sample(room, refine, prm.patch_samples)
         n, k2 = seen.shape[:2]
         e_s = (tw @ b).reshape(n, k2, 3)
@@ -300,19 +343,42 @@ class _Removal:
         # the patch from receivers that see most of it.
         under = ~past_object.all(axis=(1, 2)) | ~self._seen(centre[refine])[0]
         partial = refine[under]
-        de_partial = None
+        # groups: patches, their level k, and B and dE at the centroids of their k^2 sub-triangles.
+        groups = []
         if len(partial):
-            de_partial = self._resample(room, partial, 2 * prm.patch_samples)
+            k = 2 * prm.patch_samples
+            groups.append((partial, k, *self._resample(room, partial, k)))
             tw[:, partial], two[:, partial] = self._transport(pts, nrm, room.senders.subset(partial))
+        de_s = ((two - tw) @ b).reshape(n, k2, 3)
+        whole = refine[~under]
+        groups.append((whole, prm.patch_samples, np.broadcast_to(b[whole, None, :], (len(whole), k2, 3)), de_s[~under]))
         de = room.patch_mean((room.t_without - room.t_with) @ b)
-        de[refine] = ((two - tw) @ b).reshape(n, k2, 3).mean(axis=1)
-        if de_partial is not None:
-            de[partial] = de_partial
-        return de
+        for idx, _, _, de_g in groups:
+            de[idx] = de_g.mean(axis=1)
+        return de, self._split(room, de, groups)
+
+    def _split(self, room: _Room, de: np.ndarray, groups: list[tuple[np.ndarray, int, np.ndarray, np.ndarray]]) -> _Split:
+        """The sampled patches (groups of patches, level k, B and dE at the k^2 samples) whose
+        light varies enough to matter: what the means of B and of its first change miss over the
+        patch holds at least `bounce_tolerance` of the whole first change (the share where the
+        propagation stops). A few patches at the object's contact and shadow edges qualify;
+        important senders keep their exact per-pixel treatment."""
+        db1 = room.rho * de
+        db1[room.senders.on_removed | room.emitter] = 0.0
+        first = float((np.abs(db1) @ LUMA * room.areas).sum())
+        b = room.senders.radiosity
+        keep = []
+        for idx, k, b_g, de_g in groups:
+            db_g = room.rho[idx, None, :] * de_g
+            missed = (np.abs(b_g - b[idx, None, :]) + np.abs(db_g - db1[idx, None, :])) @ LUMA
+            sel = (missed.mean(axis=1) * room.areas[idx] >= self.params.bounce_tolerance * first) & ~room.important[idx]
+            keep.append((idx[sel], k, b_g[sel], db_g[sel]))
+        return _Split.of(room, keep)
 
     def _resample(self, room: _Room, idx: np.ndarray, k: int) -> np.ndarray:
         """Patches idx as senders sampled at k^2 points weighted by their light, dark where the
-        probe cannot see and the estimate says so; (n, 3) their first-order change of E."""
+        probe cannot see and the estimate says so; B and the first-order change of E at those
+        points (each (n, k^2, 3))."""
         b = room.senders.radiosity
         pts, nrm, tw, two, _, seen = self._sample(room, idx, k)
         e_s = (tw @ b).reshape(len(idx), k * k, 3)
@@ -323,23 +389,36 @@ class _Removal:
         room.t_with[:, idx], room.t_without[:, idx] = self._transport(room.receivers, room.receiver_normals, sub)
         tw[:, idx], two[:, idx] = self._transport(pts, nrm, sub)
         self.rep.info["resampled_patches"] = int(len(idx))
-        return ((two - tw) @ b).reshape(len(idx), k * k, 3).mean(axis=1)
+        return b_s, ((two - tw) @ b).reshape(len(idx), k * k, 3)
 
     def _sender_spheres(self, room: _Room, idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         tris = room.senders.triangles[idx]
         c = tris.mean(axis=1)
         return c, np.linalg.norm(tris - c[:, None, :], axis=2).max(axis=1)
 
-    def propagate(self, room: _Room, de1: np.ndarray) -> np.ndarray:
-        """(V, 3) irradiance change at coarse vertices from all patches' radiosity change."""
+    def propagate(self, room: _Room, de1: np.ndarray, split: _Split) -> np.ndarray:
+        """(P, 3) total radiosity change of the patches, all bounces (light sources keep theirs);
+        a split patch leaves its first change to its sub-triangles (their transport to the
+        coarse receivers is set)."""
+        p, m = len(room.areas), len(split.parent)
         db1 = room.rho * de1
         db1[room.senders.on_removed | room.emitter] = 0.0
+        db1[split.parent] = 0.0
+        split.t_with, split.t_without = self._transport(room.receivers, room.receiver_normals, split.senders)
+
+        # The sub-triangles send the first bounce only (reflectance 0): their light is gathered
+        # by the patches, which carry every later bounce.
+        def gather(db: np.ndarray) -> np.ndarray:
+            e = room.patch_mean(room.t_without @ db[:p] + split.t_without @ db[p:])
+            return np.concatenate([e, np.zeros((m, 3))])
+
         total, bounces = propagate(
-            db1, room.rho, room.areas, lambda db: room.patch_mean(room.t_without @ db),
-            self.params.bounce_tolerance, self.params.max_bounces,
+            np.concatenate([db1, split.db]), np.concatenate([room.rho, np.zeros((m, 3))]),
+            np.concatenate([room.areas, split.areas]), gather, self.params.bounce_tolerance, self.params.max_bounces,
         )
         self.rep.info["bounces"] = bounces
-        return room.t_without @ total
+        self.rep.info["split_patches"] = int(len(np.unique(split.parent)))
+        return total[:p]
 
     def _significant(self, room: _Room, imp: np.ndarray, points: np.ndarray, e_points: np.ndarray,
                      margin: float | np.ndarray = 0.0) -> np.ndarray:
@@ -354,10 +433,19 @@ class _Removal:
         bound = b_y[None] * area[None] / (np.pi * d2)
         return sv & (bound >= self.params.significance * np.maximum(e_points @ LUMA, 1e-30)[:, None])
 
-    def _fine_transport(self, room: _Room, tri: np.ndarray, bary: np.ndarray):
-        """Transport with and without the object at the vertices of a fine lattice (cells of
-        about obj_radius / fine_cells) over the triangles `tri`, only the vertices that the
-        points (tri, bary) interpolate from: (T, T', corner rows (N, 3), weights (N, 3))."""
+    def _irradiance(self, room: _Room, db: np.ndarray, split: _Split, t: np.ndarray, t_w: np.ndarray,
+                    ts: np.ndarray, ts_w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(E, E') at receivers with transport t, t_w from the patches and ts, ts_w from the
+        split patches' sub-triangles (with and without the object): the room as photographed,
+        and after removal with every bounce of the change db (P, 3)."""
+        rest = split.rest(room.senders.radiosity)
+        return t @ rest + ts @ split.b, t_w @ (rest + db) + ts_w @ (split.b + split.db)
+
+    def _fine_transport(self, room: _Room, tri: np.ndarray, bary: np.ndarray, db: np.ndarray, split: _Split):
+        """Transport with the object at the vertices of a fine lattice (cells of about
+        obj_radius / fine_cells) over the triangles `tri`, only the vertices that the points
+        (tri, bary) interpolate from, and `_irradiance` there: (T, T', E, E', corner rows (N, 3),
+        weights (N, 3))."""
         geo = self.geo
         tris_r = np.unique(tri)
         levels = np.zeros(len(geo.triangles), dtype=np.int64)
@@ -366,20 +454,26 @@ class _Removal:
         _, corners, weights = fine.locate(tri, bary)
         needed, inverse = np.unique(corners, return_inverse=True)
         self.check()
-        tf, tf_w = self._transport(_inset(fine.vertices[needed], geo.triangles[fine.vertex_tri[needed]]),
-                                   geo.normals[fine.vertex_tri[needed]], room.senders)
-        return tf, tf_w, inverse.reshape(corners.shape), weights
+        points = _inset(fine.vertices[needed], geo.triangles[fine.vertex_tri[needed]])
+        normals = geo.normals[fine.vertex_tri[needed]]
+        tf, tf_w = self._transport(points, normals, room.senders)
+        e, e_after = self._irradiance(room, db, split, tf, tf_w, *self._transport(points, normals, split.senders))
+        return tf, tf_w, e, e_after, inverse.reshape(corners.shape), weights
 
-    def local(self, room: _Room) -> tuple[np.ndarray, np.ndarray]:
-        """Per-pixel E and first-order dE; exact where the object's shadow of a light falls."""
+    def local(self, room: _Room, db: np.ndarray, split: _Split) -> tuple[np.ndarray, np.ndarray]:
+        """Per-pixel E and dE after removal (every bounce of the change db (P, 3)), exact where
+        the object's shadow of a light falls."""
         prm = self.params
         b = room.senders.radiosity
         imp = np.flatnonzero(room.important)
-        unimp = ~room.important
-        e_v = room.t_with @ b
-        de_v = (room.t_without - room.t_with)[:, unimp] @ b[unimp]
+
+        # The important senders' change is added per pixel below, exactly where it matters.
+        def change(e: np.ndarray, e_after: np.ndarray, t: np.ndarray, t_w: np.ndarray) -> np.ndarray:
+            return e_after - e - (t_w - t)[:, imp] @ b[imp]
+
+        e_v, ea_v = self._irradiance(room, db, split, room.t_with, room.t_without, split.t_with, split.t_without)
         e_pix = _interp(e_v, self.corners_h, self.weights_h)
-        de_pix = _interp(de_v, self.corners_h, self.weights_h)
+        de_pix = _interp(change(e_v, ea_v, room.t_with, room.t_without), self.corners_h, self.weights_h)
 
         cand = ~self.hidden_h & ~self.emitter_h
         if self.planes:
@@ -393,17 +487,19 @@ class _Removal:
             return e_pix, de_pix
 
         # Base for the pixel: the coarse lattice, or near the object a fine one (only the
-        # vertices the pixels use), holding all senders for E and the unimportant ones for dE.
+        # vertices the pixels use): the split patches' sub-triangles beside the object light
+        # the pixels near them unevenly, which coarse vertices would smear over a coarse patch.
         pr, ps = np.nonzero(sig)
         s = imp[ps]
         pix = ci[pr]
         lattice_e = (self.weights_h[pix] * room.t_with[self.corners_h[pix], s[:, None]]).sum(axis=1)
         ni = ci[near]
         if len(ni):
-            tf, tf_w, inverse, weights = self._fine_transport(room, self.tri_h[ni], self.hits.bary.reshape(-1, 2)[self.hp[ni]])
+            tf, tf_w, e_f, ea_f, inverse, weights = self._fine_transport(
+                room, self.tri_h[ni], self.hits.bary.reshape(-1, 2)[self.hp[ni]], db, split)
             self.rep.info["fine_vertices"] = int(len(tf))
-            e_pix[ni] = _interp(tf @ b, inverse, weights)
-            de_pix[ni] = _interp((tf_w - tf)[:, unimp] @ b[unimp], inverse, weights)
+            e_pix[ni] = _interp(e_f, inverse, weights)
+            de_pix[ni] = _interp(change(e_f, ea_f, tf, tf_w), inverse, weights)
             row = np.full(len(self.hp), -1)
             row[ni] = np.arange(len(ni))
             in_fine = row[pix] >= 0
@@ -418,15 +514,15 @@ class _Removal:
         self.rep.info["exact_pairs"] = int(len(s))
         return e_pix, de_pix
 
-    def fill_hidden(self, room: _Room, e_pix: np.ndarray, de_prop_v: np.ndarray) -> np.ndarray:
+    def fill_hidden(self, room: _Room, e_pix: np.ndarray, db: np.ndarray, split: _Split) -> np.ndarray:
         """(N, 3) radiance change of the revealed pixels (those that saw the object and see a
         surface once it is gone): synthesised reflectance lit by the irradiance after removal."""
         geo, prm = self.geo, self.params
         b = room.senders.radiosity
         tri, bary, points = self.rev_tri, self.rev_bary, self.rev_points
-        _, tf_w, inverse, weights = self._fine_transport(room, tri, bary)
-        patch, corners, w_coarse = room.lattice.locate(tri, bary)
-        e_new = _interp(tf_w @ b, inverse, weights) + _interp(de_prop_v, self.vertex_row[corners], w_coarse)
+        _, _, _, e_after, inverse, weights = self._fine_transport(room, tri, bary, db, split)
+        patch, _, _ = room.lattice.locate(tri, bary)
+        e_new = _interp(e_after, inverse, weights)
         e_new = np.maximum(e_new, 0.0)
 
         keys = self.surface_key
@@ -537,21 +633,20 @@ def remove(
         room = job.room()
     check()
     with rep.stage("first_order"):
-        de1 = job.first_order_patches(room)
+        de1, split = job.first_order_patches(room)
     with rep.stage("propagation"):
-        de_prop_v = job.propagate(room, de1)
+        db = job.propagate(room, de1, split)
     check()
     with rep.stage("local"):
-        e_pix, de_pix = job.local(room)
+        e_pix, de_pix = job.local(room, db, split)
     if len(job.revealed):
         with rep.stage("synthesis"):
-            d_revealed = job.fill_hidden(room, e_pix, de_prop_v)
+            d_revealed = job.fill_hidden(room, e_pix, db, split)
     else:
         d_revealed = np.zeros((0, 3))
         rep.skip("synthesis", "the object is not visible from the probe centre: no hidden region to fill"
                  if not job.hidden_h.any() else "nothing is behind the object to fill")
     with rep.stage("compose"):
-        de_pix = de_pix + _interp(de_prop_v, job.corners_h, job.weights_h)
         d = job.compose(e_pix, de_pix)
         d[job.revealed] = d_revealed
         h, w = job.height, job.width
