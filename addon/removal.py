@@ -20,6 +20,7 @@ from typing import Callable
 import numpy as np
 
 from . import latlong
+from .clusters import cluster_triangles, visibility_samples
 from .errors import Cancelled, DimredError
 from .formfactor import paired_point_to_triangle
 from .geometry import Geometry, boundary_objects, build_geometry, plane_of_object, surface_keys
@@ -32,7 +33,7 @@ from .raycast import Occluders, trace_panorama
 from .report import Report
 from .scene import SceneData
 from .synthesis import SynthesisParams
-from .transport import Senders, make_senders, pair_visibility, transport
+from .transport import Parts, Senders, make_senders, pair_visibility, transport
 
 _MIN_COS = 0.05  # pixels seen more grazing than this count as if at this angle (area weight)
 _VISIBLE = 0.2  # a patch is measured when pixels cover this share of its area
@@ -69,7 +70,8 @@ def _interp(values: np.ndarray, corners: np.ndarray, weights: np.ndarray) -> np.
 class _Room:
     """The coarse radiosity solution of the room as photographed."""
 
-    lattice: Lattice
+    lattice: Lattice  # the room's patches come first, in the lattice's order
+    patch_triangles: np.ndarray  # (P, 3, 3) each patch's triangle (one member of a cluster)
     senders: Senders
     important: np.ndarray  # (P,) bool
     visible: np.ndarray  # (P,) bool
@@ -80,10 +82,11 @@ class _Room:
     receiver_normals: np.ndarray  # (R, 3)
     t_with: np.ndarray  # (R, P) receiver transport with the object
     t_without: np.ndarray  # (R, P) ... and without it
-    patch_rows: np.ndarray  # (P,) receiver row of each patch's centroid
+    patch_rows: np.ndarray  # (P, K) receiver rows whose weighted mean stands for each patch
+    patch_weights: np.ndarray  # (P, K) their weights, summing to 1
 
     def patch_mean(self, receiver_values: np.ndarray) -> np.ndarray:
-        return receiver_values[self.patch_rows]
+        return _interp(receiver_values, self.patch_rows, self.patch_weights)
 
 
 @dataclass
@@ -108,7 +111,7 @@ class _Split:
         """Patches split by groups (patch indices (n,), level k, the radiosity as photographed
         and its first change at the centroids of their k^2 sub-triangles (each (n, k^2, 3)))."""
         groups = [(np.zeros(0, dtype=np.int64), 1, np.zeros((0, 1, 3)), np.zeros((0, 1, 3)))] + groups
-        ptris = room.lattice.patch_triangles()
+        ptris = room.patch_triangles
         tris = np.concatenate([split_triangles(ptris[g[0]], g[1]).reshape(-1, 3, 3) for g in groups])
         parent = np.concatenate([np.repeat(g[0], g[1] ** 2) for g in groups])
         b = np.concatenate([g[2].reshape(-1, 3) for g in groups])
@@ -200,12 +203,30 @@ class _Removal:
         target_tri = geo.tri_object == self.target
         levels = np.ones(len(geo.triangles), dtype=np.int64)
         levels[~target_tri] = levels_for_count(geo.triangles[~target_tri], prm.patches)
-        levels[target_tri] = levels_for_count(geo.triangles[target_tri], prm.object_patches)
+        # An object of many more triangles than its patch budget is clustered instead of
+        # subdivided (left out of the lattice; its patches come after the lattice's). A cluster
+        # is sampled at patch_samples^2 of its triangles, so clustering pays only past that.
+        obj = np.flatnonzero(target_tri)
+        clustered = len(obj) > prm.object_patches * prm.patch_samples ** 2
+        levels[obj] = 0 if clustered else levels_for_count(geo.triangles[obj], prm.object_patches)
         lat = build_lattice(geo.triangles, levels)
-        ptris = lat.patch_triangles()
-        pnorm = geo.normals[lat.patch_tri]
-        areas = geo.areas[lat.patch_tri] / levels[lat.patch_tri] ** 2
-        on_target = target_tri[lat.patch_tri]
+        patch_tri, areas = lat.patch_tri, geo.areas[lat.patch_tri] / levels[lat.patch_tri] ** 2
+        patch_corners = lat.patch_corners
+        parts = None
+        if clustered:
+            seen = np.isin(obj, self.tri_h)
+            cl = cluster_triangles(geo.triangles[obj].mean(axis=1), geo.normals[obj], geo.areas[obj],
+                                   prm.object_patches, self.obj_radius, seen)
+            patch_tri = np.concatenate([patch_tri, obj[cl.representative]])
+            areas = np.concatenate([areas, cl.area])
+            patch_corners = np.concatenate([patch_corners, np.zeros((len(cl.area), 3), dtype=np.int64)])
+            parts = Parts(geo.triangles[obj], geo.normals[obj], lat.n_patches + cl.label)
+            members, member_weights = visibility_samples(cl, geo.triangles[obj].mean(axis=1), geo.areas[obj],
+                                                         prm.patch_samples ** 2)
+            self.rep.info["object_clusters"] = int(len(cl.area))
+        ptris = np.concatenate([lat.patch_triangles(), geo.triangles[patch_tri[lat.n_patches:]]])
+        pnorm = geo.normals[patch_tri]
+        on_target = target_tri[patch_tri]
 
         # Receivers: the lattice vertices of the room (pixels interpolate between them), and the
         # centroid of every patch (a patch's mean: a vertex on the floor-wall edge would see the
@@ -213,13 +234,32 @@ class _Removal:
         room_vertex = ~target_tri[lat.vertex_tri]
         vertex_row = np.full(len(lat.vertices), 0, dtype=np.int64)
         vertex_row[room_vertex] = np.arange(room_vertex.sum())
-        patch_rows = room_vertex.sum() + np.arange(len(areas))
-        receivers = np.concatenate([
-            _inset(lat.vertices[room_vertex], geo.triangles[lat.vertex_tri[room_vertex]]),
-            ptris.mean(axis=1),
-        ])
-        receiver_normals = np.concatenate([geo.normals[lat.vertex_tri[room_vertex]], pnorm])
-        patch_h, corners_h, self.weights_h = lat.locate(self.tri_h, self.hits.bary.reshape(-1, 2)[self.hp])
+        # A cluster's mean is taken over its visibility samples: its light varies over it.
+        patch_rows = room_vertex.sum() + np.arange(len(areas))[:, None]
+        patch_weights = np.ones((len(areas), 1))
+        receivers = [_inset(lat.vertices[room_vertex], geo.triangles[lat.vertex_tri[room_vertex]]), ptris.mean(axis=1)]
+        receiver_normals = [geo.normals[lat.vertex_tri[room_vertex]], pnorm]
+        if clustered:
+            first = room_vertex.sum() + len(areas)
+            patch_rows = np.repeat(patch_rows, members.shape[1], axis=1)
+            patch_weights = np.pad(patch_weights, ((0, 0), (0, members.shape[1] - 1)))
+            patch_rows[lat.n_patches:] = first + np.arange(members.size).reshape(members.shape)
+            patch_weights[lat.n_patches:] = member_weights / member_weights.sum(axis=1, keepdims=True)
+            receivers.append(geo.triangles[obj[members]].mean(axis=2).reshape(-1, 3))
+            receiver_normals.append(geo.normals[obj[members]].reshape(-1, 3))
+        receivers, receiver_normals = np.concatenate(receivers), np.concatenate(receiver_normals)
+        # Pixels on a clustered object take their cluster (and no lattice vertices: hidden pixels
+        # are filled, not interpolated).
+        in_lattice = levels[self.tri_h] > 0
+        patch_h = np.zeros(len(self.hp), dtype=np.int64)
+        corners_h = np.zeros((len(self.hp), 3), dtype=np.int64)
+        self.weights_h = np.zeros((len(self.hp), 3))
+        patch_h[in_lattice], corners_h[in_lattice], self.weights_h[in_lattice] = lat.locate(
+            self.tri_h[in_lattice], self.hits.bary.reshape(-1, 2)[self.hp[in_lattice]])
+        if clustered:
+            tri_patch = np.zeros(len(geo.triangles), dtype=np.int64)
+            tri_patch[obj] = parts.owner
+            patch_h[~in_lattice] = tri_patch[self.tri_h[~in_lattice]]
         self.vertex_row = vertex_row
         self.corners_h = vertex_row[corners_h]
         self.patch_h = patch_h
@@ -251,27 +291,30 @@ class _Removal:
             (imp_idx, triangle_samples(ptris[imp_idx], prm.sender_samples)),
             (rest_idx, ptris[rest_idx].mean(axis=1)[:, None, :]),
         ]
-        senders = make_senders(ptris, pnorm, b, on_target, samples)
+        senders = make_senders(ptris, pnorm, b, on_target, samples, parts)
+        if clustered:
+            senders.resample(lat.n_patches + np.arange(len(cl.area)), geo.triangles[obj[members]].mean(axis=2),
+                             member_weights)
         self.check()
         t_with, t_without = transport(receivers, receiver_normals, senders, self.occ_removed, self.occ_others, self.check)
 
         # A light source outshines what it receives at every point; a patch partly under the
         # object may receive ~0 at its centroid only, so the test takes its brightest receiver.
-        corner_rows = np.where(on_target[:, None], patch_rows[:, None], vertex_row[lat.patch_corners])
-        test_rows = np.concatenate([patch_rows[:, None], corner_rows], axis=1)
+        corner_rows = np.where(on_target[:, None], patch_rows[:, :1], vertex_row[patch_corners])
+        test_rows = np.concatenate([patch_rows, corner_rows], axis=1)
         e_all = t_with @ b
-        e = e_all[patch_rows]
+        e = _interp(e_all, patch_rows, patch_weights)
         e_floor = 1e-9 * max(float((e @ LUMA).max()), 1e-30)
-        keys = self.surface_key[lat.patch_tri]
+        keys = self.surface_key[patch_tri]
         unseen = ~visible
         for _ in range(3):
             refl = recover_reflectance(b, e, visible, e_floor, (e_all @ LUMA)[test_rows].max(axis=1))
             measured = visible & ~refl.emitter & ((e @ LUMA) > e_floor)
-            rho = fill_unseen(refl.rho, measured, [keys, geo.tri_object[lat.patch_tri]], areas)
+            rho = fill_unseen(refl.rho, measured, [keys, geo.tri_object[patch_tri]], areas)
             rho[refl.emitter] = 0.0
             b[unseen] = rho[unseen] * e[unseen]
             e_all = t_with @ b
-            e = e_all[patch_rows]
+            e = _interp(e_all, patch_rows, patch_weights)
         senders.radiosity = b
         self.rep.guard("reflectance_clamped_patches", refl.clamped)
         self.rep.guard("irradiance_near_zero_patches", refl.guarded)
@@ -283,8 +326,8 @@ class _Removal:
             coarse_receivers=int(len(receivers)),
         )
         self.emitter_h = refl.emitter[patch_h]
-        return _Room(lat, senders, important, visible, refl.emitter, rho, areas, receivers, receiver_normals, t_with,
-                     t_without, patch_rows)
+        return _Room(lat, ptris, senders, important, visible, refl.emitter, rho, areas, receivers, receiver_normals, t_with,
+                     t_without, patch_rows, patch_weights)
 
     def _seen(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(N,) whether the probe (the origin) sees each point past the removed object, and
@@ -301,7 +344,7 @@ class _Removal:
     def _sample(self, room: _Room, idx: np.ndarray, k: int):
         """k^2 points on each patch idx (n*k^2, 3), their normals, transport with and without the
         object, and whether the probe sees them past the object and at all (each (n, k^2, 1))."""
-        pts = triangle_samples(room.lattice.patch_triangles()[idx], k).reshape(-1, 3)
+        pts = triangle_samples(room.patch_triangles[idx], k).reshape(-1, 3)
         nrm = np.repeat(room.senders.normals[idx], k * k, axis=0)
         tw, two = self._transport(pts, nrm, room.senders)
         past_object, seen = (v.reshape(len(idx), k * k, 1) for v in self._seen(pts))
@@ -319,7 +362,7 @@ class _Removal:
         reveal light that was never there, on top of the light the revealed part really gets)."""
         prm = self.params
         b = room.senders.radiosity
-        ptris = room.lattice.patch_triangles()
+        ptris = room.patch_triangles
         centre = ptris.mean(axis=1)
         radius = np.linalg.norm(ptris - centre[:, None, :], axis=2).max(axis=1)
         imp = np.flatnonzero(room.important)
