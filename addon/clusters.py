@@ -4,7 +4,9 @@ A UV sphere of 2000 triangles would otherwise be 2000 senders and 2000 receivers
 visibility against every other patch. Its light is smooth over the surface, so a cluster of
 neighbouring triangles that face about the same way can share one radiosity: k-means on the
 triangles' centroids (in units of the object's size) and normals, weighted by area, started
-from farthest points so the result is deterministic.
+from farthest points so the result is deterministic. Triangles the probe sees and ones it does
+not are clustered apart: a cluster's radiosity comes from its pixels, and one straddling the
+probe's view of the object's outline would give its unseen part the seen part's light.
 """
 from __future__ import annotations
 
@@ -57,13 +59,14 @@ def _kmeans(centroids: np.ndarray, normals: np.ndarray, areas: np.ndarray, count
     for _ in range(_ITERATIONS):
         label = _nearest(features, centres)
         weight = np.bincount(label, areas, minlength=count)
-        sums = np.stack([np.bincount(label, areas * features[:, c], minlength=count) for c in range(features.shape[1])], axis=1)
+        sums = np.stack([np.bincount(label, areas * column, minlength=count) for column in features.T], axis=1)
         # A centre that lost all its triangles stays where it was.
         centres = np.where(weight[:, None] > 0.0, sums / np.maximum(weight, 1e-300)[:, None], centres)
     return np.unique(_nearest(features, centres), return_inverse=True)[1]
 
 
-def visibility_samples(clusters: Clusters, centroids: np.ndarray, areas: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
+def visibility_samples(clusters: Clusters, centroids: np.ndarray, areas: np.ndarray, k: int
+                       ) -> tuple[np.ndarray, np.ndarray]:
     """(C, k) member triangles spread over each cluster (its representative, then each time the
     member farthest from those chosen) and (C, k) the area of the members nearest to each: the
     visibility samples of a cluster and their weights. One sample would see a cluster across an

@@ -25,13 +25,14 @@ from .errors import Cancelled, DimredError
 from .formfactor import paired_point_to_triangle
 from .geometry import Geometry, boundary_objects, build_geometry, plane_of_object, surface_keys
 from .hiddenfill import PanoramaMaps, fill_surface
-from .patches import Lattice, build_lattice, levels_for_count, levels_for_size, split_triangles, triangle_samples
+from .patches import Lattice, build_lattice, levels_for_count, levels_for_size, triangle_samples
 from .planner import neighbourhood, shadow_volume
 from .quality import Params
 from .radiosity import LUMA, RHO_MAX, fill_unseen, patch_radiosity, propagate, recover_reflectance
 from .raycast import Occluders, trace_panorama
 from .report import Report
 from .scene import SceneData
+from .split import Split
 from .synthesis import SynthesisParams
 from .transport import Parts, Senders, make_senders, pair_visibility, transport
 
@@ -87,46 +88,6 @@ class _Room:
 
     def patch_mean(self, receiver_values: np.ndarray) -> np.ndarray:
         return _interp(receiver_values, self.patch_rows, self.patch_weights)
-
-
-@dataclass
-class _Split:
-    """Patches that send through sub-triangles wherever pixels take their light.
-
-    Near the object a patch's radiosity can vary within it: dark under the object and lit
-    beside it, or changed at one end by the removal and not at the other. Spread evenly over
-    the patch, it would light a receiver beside one end as if the other end's light were there
-    too. The patch then carries only the later bounces of the change, which are smooth."""
-
-    parent: np.ndarray  # (M,) patch of each sub-triangle
-    senders: Senders  # (M,) the sub-triangles, sampled at their centroids
-    b: np.ndarray  # (M, 3) radiosity as photographed
-    db: np.ndarray  # (M, 3) first change of radiosity after removal
-    areas: np.ndarray  # (M,)
-    t_with: np.ndarray | None = None  # (R, M) the coarse receivers' transport from them, set by the propagation
-    t_without: np.ndarray | None = None  # (R, M) likewise, without the object
-
-    @classmethod
-    def of(cls, room: _Room, groups: list[tuple[np.ndarray, int, np.ndarray, np.ndarray]]) -> "_Split":
-        """Patches split by groups (patch indices (n,), level k, the radiosity as photographed
-        and its first change at the centroids of their k^2 sub-triangles (each (n, k^2, 3)))."""
-        groups = [(np.zeros(0, dtype=np.int64), 1, np.zeros((0, 1, 3)), np.zeros((0, 1, 3)))] + groups
-        ptris = room.patch_triangles
-        tris = np.concatenate([split_triangles(ptris[g[0]], g[1]).reshape(-1, 3, 3) for g in groups])
-        parent = np.concatenate([np.repeat(g[0], g[1] ** 2) for g in groups])
-        b = np.concatenate([g[2].reshape(-1, 3) for g in groups])
-        db = np.concatenate([g[3].reshape(-1, 3) for g in groups])
-        areas = np.concatenate([np.repeat(room.areas[g[0]], g[1] ** 2) / g[1] ** 2 for g in groups])
-        m = len(tris)
-        senders = make_senders(tris, room.senders.normals[parent], b, np.zeros(m, dtype=bool),
-                               [(np.arange(m), tris.mean(axis=1)[:, None, :])])
-        return cls(parent, senders, b, db, areas)
-
-    def rest(self, b: np.ndarray) -> np.ndarray:
-        """(P, 3) patch radiosities b less what the split patches send through their sub-triangles."""
-        out = b.copy()
-        out[self.parent] = 0.0
-        return out
 
 
 class _Removal:
@@ -326,8 +287,8 @@ class _Removal:
             coarse_receivers=int(len(receivers)),
         )
         self.emitter_h = refl.emitter[patch_h]
-        return _Room(lat, ptris, senders, important, visible, refl.emitter, rho, areas, receivers, receiver_normals, t_with,
-                     t_without, patch_rows, patch_weights)
+        return _Room(lat, ptris, senders, important, visible, refl.emitter, rho, areas, receivers, receiver_normals,
+                     t_with, t_without, patch_rows, patch_weights)
 
     def _seen(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(N,) whether the probe (the origin) sees each point past the removed object, and
@@ -350,7 +311,7 @@ class _Removal:
         past_object, seen = (v.reshape(len(idx), k * k, 1) for v in self._seen(pts))
         return pts, nrm, tw, two, past_object, seen
 
-    def first_order_patches(self, room: _Room) -> tuple[np.ndarray, _Split]:
+    def first_order_patches(self, room: _Room) -> tuple[np.ndarray, Split]:
         """(P, 3) first-order change of irradiance, averaged over each patch, and the split of
         those whose light varies within them (see `_split`).
 
@@ -372,7 +333,8 @@ class _Removal:
         refine = np.flatnonzero(near & ~room.senders.on_removed & ~room.emitter)
         self.rep.info["refined_patches"] = int(len(refine))
         if not len(refine):
-            return room.patch_mean((room.t_without - room.t_with) @ b), _Split.of(room, [])
+            de = room.patch_mean((room.t_without - room.t_with) @ b)
+            return de, self._split(room, de, [])
         pts, nrm, tw, two, past_object, seen = self._sample(room, refine, prm.patch_samples)
         n, k2 = seen.shape[:2]
         e_s = (tw @ b).reshape(n, k2, 3)
@@ -400,7 +362,8 @@ class _Removal:
             de[idx] = de_g.mean(axis=1)
         return de, self._split(room, de, groups)
 
-    def _split(self, room: _Room, de: np.ndarray, groups: list[tuple[np.ndarray, int, np.ndarray, np.ndarray]]) -> _Split:
+    def _split(self, room: _Room, de: np.ndarray, groups: list[tuple[np.ndarray, int, np.ndarray, np.ndarray]]
+               ) -> Split:
         """The sampled patches (groups of patches, level k, B and dE at the k^2 samples) whose
         light varies enough to matter: what the means of B and of its first change miss over the
         patch holds at least `bounce_tolerance` of the whole first change (the share where the
@@ -416,7 +379,7 @@ class _Removal:
             missed = (np.abs(b_g - b[idx, None, :]) + np.abs(db_g - db1[idx, None, :])) @ LUMA
             sel = (missed.mean(axis=1) * room.areas[idx] >= self.params.bounce_tolerance * first) & ~room.important[idx]
             keep.append((idx[sel], k, b_g[sel], db_g[sel]))
-        return _Split.of(room, keep)
+        return Split.of(room.patch_triangles, room.senders.normals, room.areas, keep)
 
     def _resample(self, room: _Room, idx: np.ndarray, k: int) -> np.ndarray:
         """Patches idx as senders sampled at k^2 points weighted by their light, dark where the
@@ -439,7 +402,7 @@ class _Removal:
         c = tris.mean(axis=1)
         return c, np.linalg.norm(tris - c[:, None, :], axis=2).max(axis=1)
 
-    def propagate(self, room: _Room, de1: np.ndarray, split: _Split) -> np.ndarray:
+    def propagate(self, room: _Room, de1: np.ndarray, split: Split) -> np.ndarray:
         """(P, 3) total radiosity change of the patches, all bounces (light sources keep theirs);
         a split patch leaves its first change to its sub-triangles (their transport to the
         coarse receivers is set)."""
@@ -476,7 +439,7 @@ class _Removal:
         bound = b_y[None] * area[None] / (np.pi * d2)
         return sv & (bound >= self.params.significance * np.maximum(e_points @ LUMA, 1e-30)[:, None])
 
-    def _irradiance(self, room: _Room, db: np.ndarray, split: _Split, t: np.ndarray, t_w: np.ndarray,
+    def _irradiance(self, room: _Room, db: np.ndarray, split: Split, t: np.ndarray, t_w: np.ndarray,
                     ts: np.ndarray, ts_w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(E, E') at receivers with transport t, t_w from the patches and ts, ts_w from the
         split patches' sub-triangles (with and without the object): the room as photographed,
@@ -484,7 +447,7 @@ class _Removal:
         rest = split.rest(room.senders.radiosity)
         return t @ rest + ts @ split.b, t_w @ (rest + db) + ts_w @ (split.b + split.db)
 
-    def _fine_transport(self, room: _Room, tri: np.ndarray, bary: np.ndarray, db: np.ndarray, split: _Split):
+    def _fine_transport(self, room: _Room, tri: np.ndarray, bary: np.ndarray, db: np.ndarray, split: Split):
         """Transport with the object at the vertices of a fine lattice (cells of about
         obj_radius / fine_cells) over the triangles `tri`, only the vertices that the points
         (tri, bary) interpolate from, and `_irradiance` there: (T, T', E, E', corner rows (N, 3),
@@ -503,7 +466,7 @@ class _Removal:
         e, e_after = self._irradiance(room, db, split, tf, tf_w, *self._transport(points, normals, split.senders))
         return tf, tf_w, e, e_after, inverse.reshape(corners.shape), weights
 
-    def local(self, room: _Room, db: np.ndarray, split: _Split) -> tuple[np.ndarray, np.ndarray]:
+    def local(self, room: _Room, db: np.ndarray, split: Split) -> tuple[np.ndarray, np.ndarray]:
         """Per-pixel E and dE after removal (every bounce of the change db (P, 3)), exact where
         the object's shadow of a light falls."""
         prm = self.params
@@ -557,7 +520,7 @@ class _Removal:
         self.rep.info["exact_pairs"] = int(len(s))
         return e_pix, de_pix
 
-    def fill_hidden(self, room: _Room, e_pix: np.ndarray, db: np.ndarray, split: _Split) -> np.ndarray:
+    def fill_hidden(self, room: _Room, e_pix: np.ndarray, db: np.ndarray, split: Split) -> np.ndarray:
         """(N, 3) radiance change of the revealed pixels (those that saw the object and see a
         surface once it is gone): synthesised reflectance lit by the irradiance after removal."""
         geo, prm = self.geo, self.params

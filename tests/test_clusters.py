@@ -11,9 +11,10 @@ def _sphere(n: int = 24) -> np.ndarray:
     """(T, 3, 3) a UV sphere of radius 1, outward winding."""
     th, ph = np.linspace(0, np.pi, n // 2 + 1), np.linspace(0, 2 * np.pi, n + 1)
     p = np.stack(np.meshgrid(th, ph, indexing="ij"), axis=-1)
-    v = np.stack([np.sin(p[..., 0]) * np.cos(p[..., 1]), np.sin(p[..., 0]) * np.sin(p[..., 1]), np.cos(p[..., 0])], axis=-1)
+    th, ph = p[..., 0], p[..., 1]
+    v = np.stack([np.sin(th) * np.cos(ph), np.sin(th) * np.sin(ph), np.cos(th)], axis=-1)
     a, b, c, d = v[:-1, :-1], v[1:, :-1], v[1:, 1:], v[:-1, 1:]
-    tris = np.concatenate([np.stack([a, b, c], axis=2).reshape(-1, 3, 3), np.stack([a, c, d], axis=2).reshape(-1, 3, 3)])
+    tris = np.concatenate([np.stack([a, b, c], axis=2), np.stack([a, c, d], axis=2)]).reshape(-1, 3, 3)
     area = np.linalg.norm(np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0]), axis=1) / 2
     return tris[area > 1e-9]
 
