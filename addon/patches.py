@@ -118,16 +118,19 @@ def build_lattice(triangles: np.ndarray, levels: np.ndarray) -> Lattice:
     return Lattice(levels, vertex_offset, patch_offset, vertices, vertex_tri, corners, patch_tri)
 
 
+def split_triangles(tris: np.ndarray, k: int) -> np.ndarray:
+    """(S, k*k, 3, 3) the k^2 congruent sub-triangles of each triangle (S, 3, 3), in the order
+    of `triangle_samples`."""
+    st, corners = _template(k)
+    st = st[corners]  # (k^2, 3, 2) barycentric (s, t) of the sub-triangles' corners
+    a = tris[:, None, None, 0]
+    return (a + st[None, ..., 0, None] * (tris[:, None, None, 1] - a)
+            + st[None, ..., 1, None] * (tris[:, None, None, 2] - a))
+
+
 def triangle_samples(tris: np.ndarray, k: int) -> np.ndarray:
     """(S, k*k, 3) centroids of the k^2 sub-triangles of each triangle (S, 3, 3)."""
-    st, corners = _template(k)
-    cent = st[corners].mean(axis=1)  # (k^2, 2) barycentric (s, t) of sub-triangle centroids
-    a = tris[:, 0]
-    return (
-        a[:, None, :]
-        + cent[None, :, 0, None] * (tris[:, 1] - a)[:, None, :]
-        + cent[None, :, 1, None] * (tris[:, 2] - a)[:, None, :]
-    )
+    return split_triangles(tris, k).mean(axis=2)
 
 
 def levels_for_size(triangles: np.ndarray, size: np.ndarray | float, max_level: int = 64) -> np.ndarray:

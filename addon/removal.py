@@ -3,6 +3,8 @@
 Three scales work together:
   * coarse patches over the whole room: radiosity from the panorama, reflectance, estimates
     for what the probe cannot see, and the propagation of the change for several bounces;
+    the few patches whose light varies within them (under the object's contact, at its
+    shadow's edge) send through sub-triangles wherever pixels take their light;
   * a fine lattice near the object: the light of the many unimportant senders and of the
     object itself, interpolated to pixels (the thesis's coarse grid of corner samples);
   * each affected pixel's own 3D point and normal: the important senders (lamps) that the
@@ -18,6 +20,7 @@ from typing import Callable
 import numpy as np
 
 from . import latlong
+from .clusters import cluster_triangles, visibility_samples
 from .errors import Cancelled, DimredError
 from .formfactor import paired_point_to_triangle
 from .geometry import Geometry, boundary_objects, build_geometry, plane_of_object, surface_keys
@@ -29,8 +32,9 @@ from .radiosity import LUMA, RHO_MAX, fill_unseen, patch_radiosity, propagate, r
 from .raycast import Occluders, trace_panorama
 from .report import Report
 from .scene import SceneData
+from .split import Split
 from .synthesis import SynthesisParams
-from .transport import Senders, make_senders, pair_visibility, transport
+from .transport import Parts, Senders, make_senders, pair_visibility, transport
 
 _MIN_COS = 0.05  # pixels seen more grazing than this count as if at this angle (area weight)
 _VISIBLE = 0.2  # a patch is measured when pixels cover this share of its area
@@ -67,7 +71,8 @@ def _interp(values: np.ndarray, corners: np.ndarray, weights: np.ndarray) -> np.
 class _Room:
     """The coarse radiosity solution of the room as photographed."""
 
-    lattice: Lattice
+    lattice: Lattice  # the room's patches come first, in the lattice's order
+    patch_triangles: np.ndarray  # (P, 3, 3) each patch's triangle (one member of a cluster)
     senders: Senders
     important: np.ndarray  # (P,) bool
     visible: np.ndarray  # (P,) bool
@@ -78,10 +83,11 @@ class _Room:
     receiver_normals: np.ndarray  # (R, 3)
     t_with: np.ndarray  # (R, P) receiver transport with the object
     t_without: np.ndarray  # (R, P) ... and without it
-    patch_rows: np.ndarray  # (P,) receiver row of each patch's centroid
+    patch_rows: np.ndarray  # (P, K) receiver rows whose weighted mean stands for each patch
+    patch_weights: np.ndarray  # (P, K) their weights, summing to 1
 
     def patch_mean(self, receiver_values: np.ndarray) -> np.ndarray:
-        return receiver_values[self.patch_rows]
+        return _interp(receiver_values, self.patch_rows, self.patch_weights)
 
 
 class _Removal:
@@ -158,12 +164,30 @@ class _Removal:
         target_tri = geo.tri_object == self.target
         levels = np.ones(len(geo.triangles), dtype=np.int64)
         levels[~target_tri] = levels_for_count(geo.triangles[~target_tri], prm.patches)
-        levels[target_tri] = levels_for_count(geo.triangles[target_tri], prm.object_patches)
+        # An object of many more triangles than its patch budget is clustered instead of
+        # subdivided (left out of the lattice; its patches come after the lattice's). A cluster
+        # is sampled at patch_samples^2 of its triangles, so clustering pays only past that.
+        obj = np.flatnonzero(target_tri)
+        clustered = len(obj) > prm.object_patches * prm.patch_samples ** 2
+        levels[obj] = 0 if clustered else levels_for_count(geo.triangles[obj], prm.object_patches)
         lat = build_lattice(geo.triangles, levels)
-        ptris = lat.patch_triangles()
-        pnorm = geo.normals[lat.patch_tri]
-        areas = geo.areas[lat.patch_tri] / levels[lat.patch_tri] ** 2
-        on_target = target_tri[lat.patch_tri]
+        patch_tri, areas = lat.patch_tri, geo.areas[lat.patch_tri] / levels[lat.patch_tri] ** 2
+        patch_corners = lat.patch_corners
+        parts = None
+        if clustered:
+            seen = np.isin(obj, self.tri_h)
+            cl = cluster_triangles(geo.triangles[obj].mean(axis=1), geo.normals[obj], geo.areas[obj],
+                                   prm.object_patches, self.obj_radius, seen)
+            patch_tri = np.concatenate([patch_tri, obj[cl.representative]])
+            areas = np.concatenate([areas, cl.area])
+            patch_corners = np.concatenate([patch_corners, np.zeros((len(cl.area), 3), dtype=np.int64)])
+            parts = Parts(geo.triangles[obj], geo.normals[obj], lat.n_patches + cl.label)
+            members, member_weights = visibility_samples(cl, geo.triangles[obj].mean(axis=1), geo.areas[obj],
+                                                         prm.patch_samples ** 2)
+            self.rep.info["object_clusters"] = int(len(cl.area))
+        ptris = np.concatenate([lat.patch_triangles(), geo.triangles[patch_tri[lat.n_patches:]]])
+        pnorm = geo.normals[patch_tri]
+        on_target = target_tri[patch_tri]
 
         # Receivers: the lattice vertices of the room (pixels interpolate between them), and the
         # centroid of every patch (a patch's mean: a vertex on the floor-wall edge would see the
@@ -171,13 +195,32 @@ class _Removal:
         room_vertex = ~target_tri[lat.vertex_tri]
         vertex_row = np.full(len(lat.vertices), 0, dtype=np.int64)
         vertex_row[room_vertex] = np.arange(room_vertex.sum())
-        patch_rows = room_vertex.sum() + np.arange(len(areas))
-        receivers = np.concatenate([
-            _inset(lat.vertices[room_vertex], geo.triangles[lat.vertex_tri[room_vertex]]),
-            ptris.mean(axis=1),
-        ])
-        receiver_normals = np.concatenate([geo.normals[lat.vertex_tri[room_vertex]], pnorm])
-        patch_h, corners_h, self.weights_h = lat.locate(self.tri_h, self.hits.bary.reshape(-1, 2)[self.hp])
+        # A cluster's mean is taken over its visibility samples: its light varies over it.
+        patch_rows = room_vertex.sum() + np.arange(len(areas))[:, None]
+        patch_weights = np.ones((len(areas), 1))
+        receivers = [_inset(lat.vertices[room_vertex], geo.triangles[lat.vertex_tri[room_vertex]]), ptris.mean(axis=1)]
+        receiver_normals = [geo.normals[lat.vertex_tri[room_vertex]], pnorm]
+        if clustered:
+            first = room_vertex.sum() + len(areas)
+            patch_rows = np.repeat(patch_rows, members.shape[1], axis=1)
+            patch_weights = np.pad(patch_weights, ((0, 0), (0, members.shape[1] - 1)))
+            patch_rows[lat.n_patches:] = first + np.arange(members.size).reshape(members.shape)
+            patch_weights[lat.n_patches:] = member_weights / member_weights.sum(axis=1, keepdims=True)
+            receivers.append(geo.triangles[obj[members]].mean(axis=2).reshape(-1, 3))
+            receiver_normals.append(geo.normals[obj[members]].reshape(-1, 3))
+        receivers, receiver_normals = np.concatenate(receivers), np.concatenate(receiver_normals)
+        # Pixels on a clustered object take their cluster (and no lattice vertices: hidden pixels
+        # are filled, not interpolated).
+        in_lattice = levels[self.tri_h] > 0
+        patch_h = np.zeros(len(self.hp), dtype=np.int64)
+        corners_h = np.zeros((len(self.hp), 3), dtype=np.int64)
+        self.weights_h = np.zeros((len(self.hp), 3))
+        patch_h[in_lattice], corners_h[in_lattice], self.weights_h[in_lattice] = lat.locate(
+            self.tri_h[in_lattice], self.hits.bary.reshape(-1, 2)[self.hp[in_lattice]])
+        if clustered:
+            tri_patch = np.zeros(len(geo.triangles), dtype=np.int64)
+            tri_patch[obj] = parts.owner
+            patch_h[~in_lattice] = tri_patch[self.tri_h[~in_lattice]]
         self.vertex_row = vertex_row
         self.corners_h = vertex_row[corners_h]
         self.patch_h = patch_h
@@ -209,27 +252,30 @@ class _Removal:
             (imp_idx, triangle_samples(ptris[imp_idx], prm.sender_samples)),
             (rest_idx, ptris[rest_idx].mean(axis=1)[:, None, :]),
         ]
-        senders = make_senders(ptris, pnorm, b, on_target, samples)
+        senders = make_senders(ptris, pnorm, b, on_target, samples, parts)
+        if clustered:
+            senders.resample(lat.n_patches + np.arange(len(cl.area)), geo.triangles[obj[members]].mean(axis=2),
+                             member_weights)
         self.check()
         t_with, t_without = transport(receivers, receiver_normals, senders, self.occ_removed, self.occ_others, self.check)
 
         # A light source outshines what it receives at every point; a patch partly under the
         # object may receive ~0 at its centroid only, so the test takes its brightest receiver.
-        corner_rows = np.where(on_target[:, None], patch_rows[:, None], vertex_row[lat.patch_corners])
-        test_rows = np.concatenate([patch_rows[:, None], corner_rows], axis=1)
+        corner_rows = np.where(on_target[:, None], patch_rows[:, :1], vertex_row[patch_corners])
+        test_rows = np.concatenate([patch_rows, corner_rows], axis=1)
         e_all = t_with @ b
-        e = e_all[patch_rows]
+        e = _interp(e_all, patch_rows, patch_weights)
         e_floor = 1e-9 * max(float((e @ LUMA).max()), 1e-30)
-        keys = self.surface_key[lat.patch_tri]
+        keys = self.surface_key[patch_tri]
         unseen = ~visible
         for _ in range(3):
             refl = recover_reflectance(b, e, visible, e_floor, (e_all @ LUMA)[test_rows].max(axis=1))
             measured = visible & ~refl.emitter & ((e @ LUMA) > e_floor)
-            rho = fill_unseen(refl.rho, measured, [keys, geo.tri_object[lat.patch_tri]], areas)
+            rho = fill_unseen(refl.rho, measured, [keys, geo.tri_object[patch_tri]], areas)
             rho[refl.emitter] = 0.0
             b[unseen] = rho[unseen] * e[unseen]
             e_all = t_with @ b
-            e = e_all[patch_rows]
+            e = _interp(e_all, patch_rows, patch_weights)
         senders.radiosity = b
         self.rep.guard("reflectance_clamped_patches", refl.clamped)
         self.rep.guard("irradiance_near_zero_patches", refl.guarded)
@@ -241,8 +287,8 @@ class _Removal:
             coarse_receivers=int(len(receivers)),
         )
         self.emitter_h = refl.emitter[patch_h]
-        return _Room(lat, senders, important, visible, refl.emitter, rho, areas, receivers, receiver_normals, t_with,
-                     t_without, patch_rows)
+        return _Room(lat, ptris, senders, important, visible, refl.emitter, rho, areas, receivers, receiver_normals,
+                     t_with, t_without, patch_rows, patch_weights)
 
     def _seen(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(N,) whether the probe (the origin) sees each point past the removed object, and
@@ -259,14 +305,15 @@ class _Removal:
     def _sample(self, room: _Room, idx: np.ndarray, k: int):
         """k^2 points on each patch idx (n*k^2, 3), their normals, transport with and without the
         object, and whether the probe sees them past the object and at all (each (n, k^2, 1))."""
-        pts = triangle_samples(room.lattice.patch_triangles()[idx], k).reshape(-1, 3)
+        pts = triangle_samples(room.patch_triangles[idx], k).reshape(-1, 3)
         nrm = np.repeat(room.senders.normals[idx], k * k, axis=0)
         tw, two = self._transport(pts, nrm, room.senders)
         past_object, seen = (v.reshape(len(idx), k * k, 1) for v in self._seen(pts))
         return pts, nrm, tw, two, past_object, seen
 
-    def first_order_patches(self, room: _Room) -> np.ndarray:
-        """(P, 3) first-order change of irradiance, averaged over each patch.
+    def first_order_patches(self, room: _Room) -> tuple[np.ndarray, Split]:
+        """(P, 3) first-order change of irradiance, averaged over each patch, and the split of
+        those whose light varies within them (see `_split`).
 
         Patches near the object are sampled at k^2 points, and the samples the probe cannot see
         correct what the pixels alone got wrong for a patch partly under or behind the object:
@@ -276,7 +323,7 @@ class _Removal:
         reveal light that was never there, on top of the light the revealed part really gets)."""
         prm = self.params
         b = room.senders.radiosity
-        ptris = room.lattice.patch_triangles()
+        ptris = room.patch_triangles
         centre = ptris.mean(axis=1)
         radius = np.linalg.norm(ptris - centre[:, None, :], axis=2).max(axis=1)
         imp = np.flatnonzero(room.important)
@@ -286,7 +333,8 @@ class _Removal:
         refine = np.flatnonzero(near & ~room.senders.on_removed & ~room.emitter)
         self.rep.info["refined_patches"] = int(len(refine))
         if not len(refine):
-            return room.patch_mean((room.t_without - room.t_with) @ b)
+            de = room.patch_mean((room.t_without - room.t_with) @ b)
+            return de, self._split(room, de, [])
         pts, nrm, tw, two, past_object, seen = self._sample(room, refine, prm.patch_samples)
         n, k2 = seen.shape[:2]
         e_s = (tw @ b).reshape(n, k2, 3)
@@ -300,19 +348,43 @@ class _Removal:
         # the patch from receivers that see most of it.
         under = ~past_object.all(axis=(1, 2)) | ~self._seen(centre[refine])[0]
         partial = refine[under]
-        de_partial = None
+        # groups: patches, their level k, and B and dE at the centroids of their k^2 sub-triangles.
+        groups = []
         if len(partial):
-            de_partial = self._resample(room, partial, 2 * prm.patch_samples)
+            k = 2 * prm.patch_samples
+            groups.append((partial, k, *self._resample(room, partial, k)))
             tw[:, partial], two[:, partial] = self._transport(pts, nrm, room.senders.subset(partial))
+        de_s = ((two - tw) @ b).reshape(n, k2, 3)
+        whole = refine[~under]
+        groups.append((whole, prm.patch_samples, np.broadcast_to(b[whole, None, :], (len(whole), k2, 3)), de_s[~under]))
         de = room.patch_mean((room.t_without - room.t_with) @ b)
-        de[refine] = ((two - tw) @ b).reshape(n, k2, 3).mean(axis=1)
-        if de_partial is not None:
-            de[partial] = de_partial
-        return de
+        for idx, _, _, de_g in groups:
+            de[idx] = de_g.mean(axis=1)
+        return de, self._split(room, de, groups)
+
+    def _split(self, room: _Room, de: np.ndarray, groups: list[tuple[np.ndarray, int, np.ndarray, np.ndarray]]
+               ) -> Split:
+        """The sampled patches (groups of patches, level k, B and dE at the k^2 samples) whose
+        light varies enough to matter: what the means of B and of its first change miss over the
+        patch holds at least `bounce_tolerance` of the whole first change (the share where the
+        propagation stops). A few patches at the object's contact and shadow edges qualify;
+        important senders keep their exact per-pixel treatment."""
+        db1 = room.rho * de
+        db1[room.senders.on_removed | room.emitter] = 0.0
+        first = float((np.abs(db1) @ LUMA * room.areas).sum())
+        b = room.senders.radiosity
+        keep = []
+        for idx, k, b_g, de_g in groups:
+            db_g = room.rho[idx, None, :] * de_g
+            missed = (np.abs(b_g - b[idx, None, :]) + np.abs(db_g - db1[idx, None, :])) @ LUMA
+            sel = (missed.mean(axis=1) * room.areas[idx] >= self.params.bounce_tolerance * first) & ~room.important[idx]
+            keep.append((idx[sel], k, b_g[sel], db_g[sel]))
+        return Split.of(room.patch_triangles, room.senders.normals, room.areas, keep)
 
     def _resample(self, room: _Room, idx: np.ndarray, k: int) -> np.ndarray:
         """Patches idx as senders sampled at k^2 points weighted by their light, dark where the
-        probe cannot see and the estimate says so; (n, 3) their first-order change of E."""
+        probe cannot see and the estimate says so; B and the first-order change of E at those
+        points (each (n, k^2, 3))."""
         b = room.senders.radiosity
         pts, nrm, tw, two, _, seen = self._sample(room, idx, k)
         e_s = (tw @ b).reshape(len(idx), k * k, 3)
@@ -323,23 +395,36 @@ class _Removal:
         room.t_with[:, idx], room.t_without[:, idx] = self._transport(room.receivers, room.receiver_normals, sub)
         tw[:, idx], two[:, idx] = self._transport(pts, nrm, sub)
         self.rep.info["resampled_patches"] = int(len(idx))
-        return ((two - tw) @ b).reshape(len(idx), k * k, 3).mean(axis=1)
+        return b_s, ((two - tw) @ b).reshape(len(idx), k * k, 3)
 
     def _sender_spheres(self, room: _Room, idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         tris = room.senders.triangles[idx]
         c = tris.mean(axis=1)
         return c, np.linalg.norm(tris - c[:, None, :], axis=2).max(axis=1)
 
-    def propagate(self, room: _Room, de1: np.ndarray) -> np.ndarray:
-        """(V, 3) irradiance change at coarse vertices from all patches' radiosity change."""
+    def propagate(self, room: _Room, de1: np.ndarray, split: Split) -> np.ndarray:
+        """(P, 3) total radiosity change of the patches, all bounces (light sources keep theirs);
+        a split patch leaves its first change to its sub-triangles (their transport to the
+        coarse receivers is set)."""
+        p, m = len(room.areas), len(split.parent)
         db1 = room.rho * de1
         db1[room.senders.on_removed | room.emitter] = 0.0
+        db1[split.parent] = 0.0
+        split.t_with, split.t_without = self._transport(room.receivers, room.receiver_normals, split.senders)
+
+        # The sub-triangles send the first bounce only (reflectance 0): their light is gathered
+        # by the patches, which carry every later bounce.
+        def gather(db: np.ndarray) -> np.ndarray:
+            e = room.patch_mean(room.t_without @ db[:p] + split.t_without @ db[p:])
+            return np.concatenate([e, np.zeros((m, 3))])
+
         total, bounces = propagate(
-            db1, room.rho, room.areas, lambda db: room.patch_mean(room.t_without @ db),
-            self.params.bounce_tolerance, self.params.max_bounces,
+            np.concatenate([db1, split.db]), np.concatenate([room.rho, np.zeros((m, 3))]),
+            np.concatenate([room.areas, split.areas]), gather, self.params.bounce_tolerance, self.params.max_bounces,
         )
         self.rep.info["bounces"] = bounces
-        return room.t_without @ total
+        self.rep.info["split_patches"] = int(len(np.unique(split.parent)))
+        return total[:p]
 
     def _significant(self, room: _Room, imp: np.ndarray, points: np.ndarray, e_points: np.ndarray,
                      margin: float | np.ndarray = 0.0) -> np.ndarray:
@@ -354,10 +439,19 @@ class _Removal:
         bound = b_y[None] * area[None] / (np.pi * d2)
         return sv & (bound >= self.params.significance * np.maximum(e_points @ LUMA, 1e-30)[:, None])
 
-    def _fine_transport(self, room: _Room, tri: np.ndarray, bary: np.ndarray):
-        """Transport with and without the object at the vertices of a fine lattice (cells of
-        about obj_radius / fine_cells) over the triangles `tri`, only the vertices that the
-        points (tri, bary) interpolate from: (T, T', corner rows (N, 3), weights (N, 3))."""
+    def _irradiance(self, room: _Room, db: np.ndarray, split: Split, t: np.ndarray, t_w: np.ndarray,
+                    ts: np.ndarray, ts_w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(E, E') at receivers with transport t, t_w from the patches and ts, ts_w from the
+        split patches' sub-triangles (with and without the object): the room as photographed,
+        and after removal with every bounce of the change db (P, 3)."""
+        rest = split.rest(room.senders.radiosity)
+        return t @ rest + ts @ split.b, t_w @ (rest + db) + ts_w @ (split.b + split.db)
+
+    def _fine_transport(self, room: _Room, tri: np.ndarray, bary: np.ndarray, db: np.ndarray, split: Split):
+        """Transport with the object at the vertices of a fine lattice (cells of about
+        obj_radius / fine_cells) over the triangles `tri`, only the vertices that the points
+        (tri, bary) interpolate from, and `_irradiance` there: (T, T', E, E', corner rows (N, 3),
+        weights (N, 3))."""
         geo = self.geo
         tris_r = np.unique(tri)
         levels = np.zeros(len(geo.triangles), dtype=np.int64)
@@ -366,20 +460,26 @@ class _Removal:
         _, corners, weights = fine.locate(tri, bary)
         needed, inverse = np.unique(corners, return_inverse=True)
         self.check()
-        tf, tf_w = self._transport(_inset(fine.vertices[needed], geo.triangles[fine.vertex_tri[needed]]),
-                                   geo.normals[fine.vertex_tri[needed]], room.senders)
-        return tf, tf_w, inverse.reshape(corners.shape), weights
+        points = _inset(fine.vertices[needed], geo.triangles[fine.vertex_tri[needed]])
+        normals = geo.normals[fine.vertex_tri[needed]]
+        tf, tf_w = self._transport(points, normals, room.senders)
+        e, e_after = self._irradiance(room, db, split, tf, tf_w, *self._transport(points, normals, split.senders))
+        return tf, tf_w, e, e_after, inverse.reshape(corners.shape), weights
 
-    def local(self, room: _Room) -> tuple[np.ndarray, np.ndarray]:
-        """Per-pixel E and first-order dE; exact where the object's shadow of a light falls."""
+    def local(self, room: _Room, db: np.ndarray, split: Split) -> tuple[np.ndarray, np.ndarray]:
+        """Per-pixel E and dE after removal (every bounce of the change db (P, 3)), exact where
+        the object's shadow of a light falls."""
         prm = self.params
         b = room.senders.radiosity
         imp = np.flatnonzero(room.important)
-        unimp = ~room.important
-        e_v = room.t_with @ b
-        de_v = (room.t_without - room.t_with)[:, unimp] @ b[unimp]
+
+        # The important senders' change is added per pixel below, exactly where it matters.
+        def change(e: np.ndarray, e_after: np.ndarray, t: np.ndarray, t_w: np.ndarray) -> np.ndarray:
+            return e_after - e - (t_w - t)[:, imp] @ b[imp]
+
+        e_v, ea_v = self._irradiance(room, db, split, room.t_with, room.t_without, split.t_with, split.t_without)
         e_pix = _interp(e_v, self.corners_h, self.weights_h)
-        de_pix = _interp(de_v, self.corners_h, self.weights_h)
+        de_pix = _interp(change(e_v, ea_v, room.t_with, room.t_without), self.corners_h, self.weights_h)
 
         cand = ~self.hidden_h & ~self.emitter_h
         if self.planes:
@@ -393,17 +493,19 @@ class _Removal:
             return e_pix, de_pix
 
         # Base for the pixel: the coarse lattice, or near the object a fine one (only the
-        # vertices the pixels use), holding all senders for E and the unimportant ones for dE.
+        # vertices the pixels use): the split patches' sub-triangles beside the object light
+        # the pixels near them unevenly, which coarse vertices would smear over a coarse patch.
         pr, ps = np.nonzero(sig)
         s = imp[ps]
         pix = ci[pr]
         lattice_e = (self.weights_h[pix] * room.t_with[self.corners_h[pix], s[:, None]]).sum(axis=1)
         ni = ci[near]
         if len(ni):
-            tf, tf_w, inverse, weights = self._fine_transport(room, self.tri_h[ni], self.hits.bary.reshape(-1, 2)[self.hp[ni]])
+            tf, tf_w, e_f, ea_f, inverse, weights = self._fine_transport(
+                room, self.tri_h[ni], self.hits.bary.reshape(-1, 2)[self.hp[ni]], db, split)
             self.rep.info["fine_vertices"] = int(len(tf))
-            e_pix[ni] = _interp(tf @ b, inverse, weights)
-            de_pix[ni] = _interp((tf_w - tf)[:, unimp] @ b[unimp], inverse, weights)
+            e_pix[ni] = _interp(e_f, inverse, weights)
+            de_pix[ni] = _interp(change(e_f, ea_f, tf, tf_w), inverse, weights)
             row = np.full(len(self.hp), -1)
             row[ni] = np.arange(len(ni))
             in_fine = row[pix] >= 0
@@ -418,7 +520,7 @@ class _Removal:
         self.rep.info["exact_pairs"] = int(len(s))
         return e_pix, de_pix
 
-    def fill_hidden(self, room: _Room, e_pix: np.ndarray, de_prop_v: np.ndarray,
+    def fill_hidden(self, room: _Room, e_pix: np.ndarray, db: np.ndarray, split: Split,
                     show: Callable[[np.ndarray], None] | None = None) -> np.ndarray:
         """(N, 3) radiance change of the revealed pixels (those that saw the object and see a
         surface once it is gone): synthesised reflectance lit by the irradiance after removal.
@@ -428,9 +530,9 @@ class _Removal:
         geo, prm = self.geo, self.params
         b = room.senders.radiosity
         tri, bary, points = self.rev_tri, self.rev_bary, self.rev_points
-        _, tf_w, inverse, weights = self._fine_transport(room, tri, bary)
-        patch, corners, w_coarse = room.lattice.locate(tri, bary)
-        e_new = _interp(tf_w @ b, inverse, weights) + _interp(de_prop_v, self.vertex_row[corners], w_coarse)
+        _, _, _, e_after, inverse, weights = self._fine_transport(room, tri, bary, db, split)
+        patch, _, _ = room.lattice.locate(tri, bary)
+        e_new = _interp(e_after, inverse, weights)
         e_new = np.maximum(e_new, 0.0)
 
         keys = self.surface_key
@@ -557,14 +659,14 @@ def remove(
         room = job.room()
     check()
     with rep.stage("first_order"):
-        de1 = job.first_order_patches(room)
+        de1, split = job.first_order_patches(room)
     with rep.stage("propagation"):
-        de_prop_v = job.propagate(room, de1)
+        db = job.propagate(room, de1, split)
     check()
     with rep.stage("local"):
-        e_pix, de_pix = job.local(room)
+        e_pix, de_pix = job.local(room, db, split)
     with rep.stage("compose"):
-        d = job.compose(e_pix, de_pix + _interp(de_prop_v, job.corners_h, job.weights_h))
+        d = job.compose(e_pix, de_pix)
 
     def difference_image(d_revealed: np.ndarray) -> np.ndarray:
         d[job.revealed] = d_revealed
@@ -575,7 +677,7 @@ def remove(
     if len(job.revealed):
         show = None if preview is None else lambda d_revealed: preview(difference_image(d_revealed))
         with rep.stage("synthesis"):
-            d_revealed = job.fill_hidden(room, e_pix, de_prop_v, show)
+            d_revealed = job.fill_hidden(room, e_pix, db, split, show)
     else:
         d_revealed = np.zeros((0, 3))
         rep.skip("synthesis", "the object is not visible from the probe centre: no hidden region to fill"

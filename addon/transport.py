@@ -23,6 +23,16 @@ _SEGMENTS_PER_CHUNK = 300_000
 
 
 @dataclass
+class Parts:
+    """Senders made of several triangles (clusters of a finely tessellated object): the member
+    triangles, their normals and their sender. Form factors add up over the members."""
+
+    triangles: np.ndarray  # (T, 3, 3)
+    normals: np.ndarray  # (T, 3)
+    owner: np.ndarray  # (T,) sender of each member
+
+
+@dataclass
 class Senders:
     """Sender patches: triangles, normals, and the visibility sample points of each.
 
@@ -40,6 +50,7 @@ class Senders:
     slot: np.ndarray  # (S,) row in that group's samples
     samples: list[np.ndarray]  # per group: (n_g, m_g, 3)
     weights: list[np.ndarray]  # per group: (n_g, m_g), each row summing to 1
+    parts: Parts | None = None  # senders of several triangles (triangles then holds one member of each)
 
     def __len__(self) -> int:
         return len(self.triangles)
@@ -55,11 +66,18 @@ class Senders:
 
     def subset(self, idx: np.ndarray) -> "Senders":
         """The senders `idx` alone (sharing the sample groups)."""
+        parts = None
+        if self.parts is not None:
+            row = np.full(len(self), -1)
+            row[idx] = np.arange(len(idx))
+            keep = row[self.parts.owner] >= 0
+            parts = Parts(self.parts.triangles[keep], self.parts.normals[keep], row[self.parts.owner[keep]])
         return Senders(self.triangles[idx], self.normals[idx], self.radiosity[idx], self.on_removed[idx],
-                       self.group[idx], self.slot[idx], self.samples, self.weights)
+                       self.group[idx], self.slot[idx], self.samples, self.weights, parts)
 
 
-def make_senders(triangles, normals, radiosity, on_removed, sample_sets: list[tuple[np.ndarray, np.ndarray]]) -> Senders:
+def make_senders(triangles, normals, radiosity, on_removed, sample_sets: list[tuple[np.ndarray, np.ndarray]],
+                 parts: Parts | None = None) -> Senders:
     """Senders from (indices, samples) pairs that together cover every sender once."""
     group = np.zeros(len(triangles), dtype=np.int64)
     slot = np.zeros(len(triangles), dtype=np.int64)
@@ -67,7 +85,21 @@ def make_senders(triangles, normals, radiosity, on_removed, sample_sets: list[tu
         group[idx] = g
         slot[idx] = np.arange(len(idx))
     return Senders(triangles, normals, radiosity, on_removed, group, slot, [smp for _, smp in sample_sets],
-                   [np.full(smp.shape[:2], 1.0 / smp.shape[1]) for _, smp in sample_sets])
+                   [np.full(smp.shape[:2], 1.0 / smp.shape[1]) for _, smp in sample_sets], parts)
+
+
+def form_factors(points: np.ndarray, normals: np.ndarray, senders: Senders) -> np.ndarray:
+    """(R, S) form factors from receivers (R, 3) with normals (R, 3) to the senders, summed over
+    the members of senders made of several triangles."""
+    f = point_to_triangle(points, normals, senders.triangles, senders.normals)
+    parts = senders.parts
+    if parts is not None and len(parts.owner):
+        order = np.argsort(parts.owner, kind="stable")
+        owner = parts.owner[order]
+        start = np.flatnonzero(np.r_[True, np.diff(owner) > 0])
+        member = point_to_triangle(points, normals, parts.triangles[order], parts.normals[order])
+        f[:, owner[start]] = np.add.reduceat(member, start, axis=1)
+    return f
 
 
 def pair_visibility(
@@ -107,7 +139,7 @@ def transport(
     cancel=None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """(T, T') as dense (R, S) float64 matrices for receivers (R, 3) with normals (R, 3)."""
-    f = point_to_triangle(points, normals, senders.triangles, senders.normals)
+    f = form_factors(points, normals, senders)
     r, s = np.nonzero(f > 0.0)
     vis, vis_without = pair_visibility(points, senders, r, s, removed, others, cancel)
     t_with = np.zeros_like(f)

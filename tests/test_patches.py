@@ -1,7 +1,7 @@
 """Patch lattices: areas add up, points locate in the right patch, interpolation is exact for linear fields."""
 import numpy as np
 
-from addon.patches import build_lattice, levels_for_count, levels_for_size, triangle_samples
+from addon.patches import build_lattice, levels_for_count, levels_for_size, split_triangles, triangle_samples
 
 
 def _random_points(tris, tri, rng):
@@ -45,3 +45,14 @@ def test_levels_and_samples():
     assert 500 <= count <= 2000
     s = triangle_samples(tris, 3)
     assert s.shape == (1, 9, 3) and np.allclose(s[0].mean(axis=0), tris[0].mean(axis=0))
+
+
+def test_split_triangles_tile_the_triangle_around_the_samples():
+    rng = np.random.default_rng(3)
+    tris = rng.normal(size=(3, 3, 3))
+    sub = split_triangles(tris, 4)
+    assert sub.shape == (3, 16, 3, 3)
+    area = np.linalg.norm(np.cross(sub[..., 1, :] - sub[..., 0, :], sub[..., 2, :] - sub[..., 0, :]), axis=-1) / 2
+    whole = np.linalg.norm(np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0]), axis=1) / 2
+    assert np.allclose(area, whole[:, None] / 16)  # congruent, and together the whole triangle
+    assert np.allclose(sub.mean(axis=2), triangle_samples(tris, 4))
