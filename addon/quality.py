@@ -19,7 +19,8 @@ class Params:
     sender_fraction: float = 0.98  # important senders hold this share of the bright patches' power
     max_senders: int = 32  # ... but at most this many (thesis default: 32)
     sender_samples: int = 4  # k: an important sender is sampled at k*k points for visibility
-    fine_cells: float = 3.0  # fine grid: cells per object radius, near the object
+    fine_cells: float = 3.0  # fine grid: cells per object radius, near the object ...
+    fine_pixels: float = 5.0  # ... and at most this many panorama pixels wide at the object's distance
     reach: float = 0.1  # the object's neighbourhood (fine lattice): where its solid angle exceeds this
     significance: float = 0.01  # shadow of a light computed per pixel where it can change E by this share
     bright_factor: float = 4.0  # important senders are this many times brighter than the median patch
@@ -36,11 +37,11 @@ class Params:
 
 PRESETS = {
     "draft": Params(patches=200, object_patches=40, sender_fraction=0.9, max_senders=12, sender_samples=2,
-                    fine_cells=2.0, reach=0.15, significance=0.03, patch_samples=1, max_bounces=4,
+                    fine_cells=2.0, fine_pixels=8.0, reach=0.15, significance=0.03, patch_samples=1, max_bounces=4,
                     bounce_tolerance=1e-2),
     "balanced": Params(),
     "final": Params(patches=1200, object_patches=300, sender_fraction=0.995, max_senders=64, sender_samples=6,
-                    fine_cells=5.0, reach=0.05, significance=0.003, patch_samples=3, max_bounces=16,
+                    fine_cells=5.0, fine_pixels=3.0, reach=0.05, significance=0.003, patch_samples=3, max_bounces=16,
                     bounce_tolerance=5e-4),
 }
 

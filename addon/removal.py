@@ -105,6 +105,11 @@ class _Removal:
         self.surface_key = surface_keys(geo)
         self.eps = 1e-6 * geo.scale
         self.obj_centre, self.obj_radius = geo.bounding_sphere(self.target)
+        # The fine grid must resolve what the pixels show: the contact shadow where the object
+        # touches the floor or a wall is a few centimetres wide, and interpolating it over coarse
+        # cells darkens the pixels beside the object (E too low, so the ratio over-brightens).
+        pixel = float(np.linalg.norm(self.obj_centre)) * np.pi / self.height
+        self.fine_cell = min(self.obj_radius / self.params.fine_cells, self.params.fine_pixels * pixel)
 
     def trace(self) -> None:
         hits = trace_panorama(self.geo.triangles, self.width, self.height)
@@ -449,13 +454,13 @@ class _Removal:
 
     def _fine_transport(self, room: _Room, tri: np.ndarray, bary: np.ndarray, db: np.ndarray, split: Split):
         """Transport with the object at the vertices of a fine lattice (cells of about
-        obj_radius / fine_cells) over the triangles `tri`, only the vertices that the points
+        `fine_cell`) over the triangles `tri`, only the vertices that the points
         (tri, bary) interpolate from, and `_irradiance` there: (T, T', E, E', corner rows (N, 3),
         weights (N, 3))."""
         geo = self.geo
         tris_r = np.unique(tri)
         levels = np.zeros(len(geo.triangles), dtype=np.int64)
-        levels[tris_r] = levels_for_size(geo.triangles[tris_r], self.obj_radius / self.params.fine_cells, max_level=512)
+        levels[tris_r] = levels_for_size(geo.triangles[tris_r], self.fine_cell, max_level=512)
         fine = build_lattice(geo.triangles, levels)
         _, corners, weights = fine.locate(tri, bary)
         needed, inverse = np.unique(corners, return_inverse=True)
