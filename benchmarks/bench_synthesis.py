@@ -126,6 +126,7 @@ def main() -> None:
     ap.add_argument("--image", type=int, default=512, help="side of the square test images")
     ap.add_argument("--exhaustive-max", type=int, default=64, help="largest hole the exhaustive search runs on")
     ap.add_argument("--quick", action="store_true", help="holes 64 and 128 only, no exhaustive search")
+    ap.add_argument("--methods", default="", help="run only these methods, comma separated (default: all)")
     args = ap.parse_args()
     sizes = [64, 128] if args.quick else [int(s) for s in args.sizes.split(",")]
     exhaustive_max = 0 if args.quick else args.exhaustive_max
@@ -137,6 +138,8 @@ def main() -> None:
             methods[name] = make()
         except (ImportError, OSError) as e:
             methods[name] = f"not installed ({e.__class__.__name__})"
+    if args.methods:
+        methods = {name: methods[name] for name in args.methods.split(",")}
 
     print(f"{args.image}x{args.image} images, square hole in the middle; default parameters {SynthesisParams()}")
     print()
