@@ -626,42 +626,40 @@ def _harmonic(values: np.ndarray, fixed: np.ndarray, region: np.ndarray) -> np.n
     out = np.zeros(values.shape, np.float32)
     if not region.any():
         return out
-    ys, xs = np.nonzero(region)
-    y0, y1, x0, x1 = _bounding_box(ys, xs, 1, region.shape)
-    inside, known = region[y0:y1, x0:x1], fixed[y0:y1, x0:x1] & ~region[y0:y1, x0:x1]
-    v = np.where(known[..., None], values[y0:y1, x0:x1], 0).astype(np.float64)
-    links = [(_shift(inside, d), _shift(known, d)) for d in _STEPS4]  # per direction: neighbour unknown, fixed
-    degree = sum(u.astype(np.float64) + k for u, k in links) * inside
+    y0, y1, x0, x1 = _bounding_box(*np.nonzero(region), 1, region.shape)
+    inside = region[y0:y1, x0:x1]
+    known = fixed[y0:y1, x0:x1] & ~inside
+    # per direction, whether the neighbour is an unknown (couples) or fixed (goes into b), on unknowns only
+    unknown_nb = [(_neighbour(inside, d) & inside)[..., None].astype(np.float32) for d in _STEPS4]
+    fixed_nb = [(_neighbour(known, d) & inside)[..., None].astype(np.float32) for d in _STEPS4]
+    degree = sum(unknown_nb) + sum(fixed_nb)
+    v = np.where(known[..., None], values[y0:y1, x0:x1], 0).astype(np.float32)
+    b = sum(f * _neighbour(v, d) for f, d in zip(fixed_nb, _STEPS4))
 
-    def apply(x):  # the Laplacian on the unknowns (x is 0 elsewhere)
-        lap = degree[..., None] * x - sum(np.where(u[..., None], _shift(x, d), 0) for (u, _), d in zip(links, _STEPS4))
-        return lap * inside[..., None]
+    def laplacian(x: np.ndarray) -> np.ndarray:  # on the unknowns; x is 0 elsewhere, so is the result
+        return degree * x - sum(u * _neighbour(x, d) for u, d in zip(unknown_nb, _STEPS4))
 
-    b = sum(np.where(k[..., None], _shift(v, d), 0) for (_, k), d in zip(links, _STEPS4)) * inside[..., None]
-    x = np.where(inside[..., None], _pull_push(values, fixed.astype(np.float32))[y0:y1, x0:x1], 0).astype(np.float64)
-    r = b - apply(x)
-    p, rr = r.copy(), (r * r).sum(axis=(0, 1))
-    stop = 1e-6 * np.maximum((b * b).sum(axis=(0, 1)), 1e-30)
+    x = np.where(inside[..., None], _pull_push(values, fixed.astype(np.float32))[y0:y1, x0:x1], 0).astype(np.float32)
+    r = b - laplacian(x)
+    p, rr = r.copy(), np.einsum("yxc,yxc->c", r, r)
     for _ in range(_MEMBRANE_STEPS):
-        if (rr <= stop).all():
+        if not rr.any():  # solved exactly (e.g. a constant border)
             break
-        ap = apply(p)
-        alpha = rr / np.maximum((p * ap).sum(axis=(0, 1)), 1e-30)
+        ap = laplacian(p)
+        alpha = rr / np.maximum(np.einsum("yxc,yxc->c", p, ap), 1e-30)
         x += alpha * p
         r -= alpha * ap
-        rr, rr_old = (r * r).sum(axis=(0, 1)), rr
+        rr, rr_old = np.einsum("yxc,yxc->c", r, r), rr
         p = r + rr / np.maximum(rr_old, 1e-30) * p
-    out[y0:y1, x0:x1] = np.where(inside[..., None], x, 0)
+    out[y0:y1, x0:x1] = x
     return out
 
 
-def _shift(a: np.ndarray, d: tuple[int, int]) -> np.ndarray:
-    """a moved so that out[y, x] = a[y + dy, x + dx] (0 / False beyond the edge)."""
-    out = np.zeros_like(a)
-    dy, dx = d
+def _neighbour(a: np.ndarray, d: tuple[int, int]) -> np.ndarray:
+    """out[y, x] = a[y + dy, x + dx] for a step d = (dy, dx) of at most 1 (0 / False beyond the edge)."""
+    pad = np.pad(a, [(1, 1), (1, 1)] + [(0, 0)] * (a.ndim - 2))
     h, w = a.shape[:2]
-    out[max(-dy, 0):h - max(dy, 0), max(-dx, 0):w - max(dx, 0)] = a[max(dy, 0):h + min(dy, 0), max(dx, 0):w + min(dx, 0)]
-    return out
+    return pad[1 + d[0]:1 + d[0] + h, 1 + d[1]:1 + d[1] + w]
 
 
 def _pull_push(values: np.ndarray, weight: np.ndarray) -> np.ndarray:
