@@ -116,11 +116,13 @@ def fill(
     or an exemplar with too few complete neighbourhoods.
     """
     synth = OrderIndependentSynthesis(image, known, hole, params, exemplar, exemplar_valid, seed, cancel)
-    for level in range(synth.levels - 1, -1, -1):
-        synth.level_image(level)
-        if progress is not None:
+    if progress is not None:  # without it, level 0 computes of the coarser levels just what it reads
+        for level in range(synth.levels - 1, 0, -1):
             progress(level, synth.preview(level))
-    return synth.preview(0)
+    out = synth.preview(0)
+    if progress is not None:
+        progress(0, out)
+    return out
 
 
 class OrderIndependentSynthesis:
@@ -637,9 +639,12 @@ def _harmonic(values: np.ndarray, fixed: np.ndarray, region: np.ndarray) -> np.n
     b = sum(f * _neighbour(v, d) for f, d in zip(fixed_nb, _STEPS4))
 
     def laplacian(x: np.ndarray) -> np.ndarray:  # on the unknowns; x is 0 elsewhere, so is the result
-        return degree * x - sum(u * _neighbour(x, d) for u, d in zip(unknown_nb, _STEPS4))
+        xp = np.pad(x, ((1, 1), (1, 1), (0, 0)))
+        h, w = x.shape[:2]
+        return degree * x - sum(u * xp[1 + dy:1 + dy + h, 1 + dx:1 + dx + w] for u, (dy, dx) in zip(unknown_nb, _STEPS4))
 
-    x = np.where(inside[..., None], _pull_push(values, fixed.astype(np.float32))[y0:y1, x0:x1], 0).astype(np.float32)
+    start = _pull_push(values[y0:y1, x0:x1], fixed[y0:y1, x0:x1].astype(np.float32))  # the box holds all fixed pixels that count
+    x = np.where(inside[..., None], start, 0).astype(np.float32)
     r = b - laplacian(x)
     p, rr = r.copy(), np.einsum("yxc,yxc->c", r, r)
     for _ in range(_MEMBRANE_STEPS):
