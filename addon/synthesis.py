@@ -16,8 +16,9 @@ copies along the shifts under which the hole's surroundings recur ("offsets") st
 carrying tile and plank lines across large holes; and a smooth correction removes shade steps at
 the hole's border. All three read only coarser levels, earlier generations and known pixels.
 
-Neighbourhood vectors are quantised to integers small enough that every squared distance, also
-through float32 matrix products, is an exact integer. So no result depends on batch shape or
+Neighbourhood vectors are quantised to integers (bytes: the exemplar's vectors, read at random by
+the search, take a quarter of the memory of floats) small enough that every squared distance,
+also through float32 matrix products, is an exact integer. So no result depends on batch shape or
 summation order, which makes on-demand requests bit-identical to `fill`, and randomness is a hash
 of (seed, level, generation, y, x), never a sequential stream.
 """
@@ -160,7 +161,7 @@ class OrderIndependentSynthesis:
         n, c = params.neighbourhood, image.shape[2]
         lo, hi = float(ex_image[ex_valid].min()), float(ex_image[ex_valid].max())
         self._lo = lo
-        self._qmax = int(np.sqrt(_EXACT / ((n * n + 9) * c)))
+        self._qmax = min(255, int(np.sqrt(_EXACT / ((n * n + 9) * c))))  # bytes, and exact squared distances
         self._scale = self._qmax / (hi - lo) if hi > lo else 1.0
 
         levels = params.levels or _auto_levels(hole, n)
@@ -360,9 +361,9 @@ class OrderIndependentSynthesis:
 
     def _quantised_planes(self, level: np.ndarray, ok: np.ndarray, coarse: tuple | None,
                           box: tuple[int, int, int, int] | None = None) -> list[tuple]:
-        """`_planes` with integer values: rint((v - lo) * scale) clipped to 0..qmax, 0 where not ok."""
+        """`_planes` with byte values: rint((v - lo) * scale) clipped to 0..qmax, 0 where not ok."""
         return [(np.where(o[..., None], np.clip(np.rint((v - self._lo) * self._scale), 0, self._qmax), 0)
-                 .astype(np.float32), o, size, step)
+                 .astype(np.uint8), o, size, step)
                 for v, o, size, step in _planes(level, ok, coarse, self._params.neighbourhood, box)]
 
     def _exemplar_level(self, pyr: list, l: int, levels: int) -> _ExemplarLevel:
@@ -373,14 +374,15 @@ class OrderIndependentSynthesis:
         planes = self._quantised_planes(values, valid, coarse)
         pos = np.stack(np.nonzero(_complete(planes)), axis=1)
         d = sum(size * size for _, _, size, _ in planes) * values.shape[2]
-        vec = np.empty((len(pos), d), np.float32)
+        vec = np.empty((len(pos), d), np.uint8)
         views = _value_windows(planes)
         rows = max(1, _CHUNK // d)
         for s in range(0, len(pos), rows):
             vec[s:s + rows] = _take_windows(views, pos[s:s + rows, 0], pos[s:s + rows, 1])
         index = np.full(valid.shape, -1, np.int64)
         index[pos[:, 0], pos[:, 1]] = np.arange(len(pos))
-        return _ExemplarLevel(values.astype(np.float32), valid, pos, index, vec, np.einsum("nd,nd->n", vec, vec))
+        return _ExemplarLevel(values.astype(np.float32), valid, pos, index, vec,
+                              np.einsum("nd,nd->n", vec, vec, dtype=np.float32))
 
 
 @dataclass
@@ -389,7 +391,7 @@ class _ExemplarLevel:
     valid: np.ndarray  # (h, w) pixels whose whole blur footprint was exemplar
     pos: np.ndarray  # (N, 2) centres of complete windows
     index: np.ndarray  # (h, w) row of each centre in pos and vec, -1 elsewhere
-    vec: np.ndarray  # (N, D) quantised neighbourhoods: integers in float32
+    vec: np.ndarray  # (N, D) quantised neighbourhoods (uint8)
     sq: np.ndarray  # (N,) their squared norms
 
 
@@ -520,10 +522,11 @@ def _nearest(ex: np.ndarray, sq: np.ndarray, q: np.ndarray, w: np.ndarray) -> np
     same for every e, so it is left out. All terms are exact integers in float32."""
     out = np.empty(len(q), np.int64)
     rows = max(1, 4 * _CHUNK // max(len(ex), 1))  # tall products: packing the exemplar costs per call
+    ex = ex.astype(np.float32)  # matrix products run on floats
     ex_t = np.ascontiguousarray(ex.T)
     sq_t = None
     for s in range(0, len(q), rows):
-        qs, ws = q[s:s + rows], w[s:s + rows]
+        qs, ws = q[s:s + rows].astype(np.float32), w[s:s + rows]
         if ws.all():
             d = sq[None, :] - 2 * (qs @ ex_t)
         else:
@@ -547,10 +550,9 @@ def _best_candidate(ex: np.ndarray, sq: np.ndarray, q: np.ndarray, w: np.ndarray
         d = np.full(c.shape, np.inf, np.float32)
         full = ws.all(axis=1)
         r, k = np.nonzero(_first_occurrences(c) & full[:, None])
-        e = ex[c[r, k]]
-        d[r, k] = sq[c[r, k]] - 2 * np.einsum("pd,pd->p", e, qs[r])
+        d[r, k] = sq[c[r, k]] - 2 * np.einsum("pd,pd->p", ex[c[r, k]], qs[r], dtype=np.float32)
         if not full.all():
-            em = ex[np.maximum(c[~full], 0)]
+            em, qs = ex[np.maximum(c[~full], 0)].astype(np.float32), qs.astype(np.float32)
             dm = np.einsum("mkd,md->mk", em * em, ws[~full]) - 2 * np.einsum("mkd,md->mk", em, qs[~full])
             d[~full] = np.where(c[~full] >= 0, dm, np.inf)
         out[s:s + rows] = c[np.arange(len(c)), d.argmin(axis=1)]
