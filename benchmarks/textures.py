@@ -3,6 +3,9 @@
 tiles: 64 px tiles with 3 px grout and mottled, slightly varying tile colours; planks: wood planks
 48 px wide with grain and staggered joints; noise: stochastic gravel-like multi-scale noise;
 gradient: a smooth diagonal gradient with faint noise.
+
+`lighting` gives the irradiance on such a floor before and after an object is removed from it: a
+lamp's falloff, and the object's soft shadow, which the removal takes away.
 """
 from __future__ import annotations
 
@@ -62,6 +65,22 @@ def gradient(size: int = 512, seed: int = 0) -> np.ndarray:
     t = 0.6 * x + 0.4 * y
     img = np.stack([0.2 + 0.6 * t, 0.3 + 0.4 * t, 0.6 - 0.3 * t], axis=-1)
     return np.clip(img + 0.01 * rng.standard_normal((size, size, 1)), 0, 1).astype(np.float32)
+
+
+def lighting(size: int, hole: tuple[int, int, int, int]) -> tuple[np.ndarray, np.ndarray]:
+    """Irradiance (H, W, 1) on a size x size floor with the object, and after its removal (E').
+
+    E' is a lamp off the image's upper left corner (the falloff of a point light over a plane: 1.05
+    near it, 0.33 in the far corner). E is E' times the object's soft shadow: a Gaussian
+    darkening to 35 % at its centre, which lies inside the hole (y0, y1, x0, x1) near its lower right
+    corner, so half the shadow falls on the visible floor beside the hole.
+    """
+    y, x = np.mgrid[:size, :size] / size
+    after = 1.05 / (1 + ((x + 0.1) ** 2 + (y + 0.1) ** 2) / 2.07) ** 1.5
+    y0, y1, x0, x1 = hole
+    cy, cx, sigma = (y0 + 0.8 * (y1 - y0)) / size, (x0 + 0.8 * (x1 - x0)) / size, 0.3 * (y1 - y0) / size
+    shadow = 1 - 0.65 * np.exp(-((y - cy) ** 2 + (x - cx) ** 2) / (2 * sigma ** 2))
+    return (after * shadow)[..., None].astype(np.float32), after[..., None].astype(np.float32)
 
 
 TEXTURES = {"tiles": tiles, "planks": planks, "noise": noise, "gradient": gradient}
