@@ -57,12 +57,14 @@ def fill_surface(
     seed: int = 0,
     cancel: Callable[[], bool] | None = None,
     progress: Callable[[np.ndarray], None] | None = None,
+    along: np.ndarray | None = None,
 ) -> SurfaceFill:
     """Reflectance at the hidden `points` (N, 3) of one plane, synthesised on a raster with cells
     of about `cell` covering them and `margin` times their extent around, from the panorama's
-    reflectance `rho_image` (H, W, 3) where `rho_valid`. `progress(rho)` gets the (N, 3)
+    reflectance `rho_image` (H, W, 3) where `rho_valid`; the raster's axes follow `along` on a
+    floor or ceiling (`planeraster.plane_axes`). `progress(rho)` gets the (N, 3)
     reflectance at `points` after each synthesis level, coarsest first."""
-    raster = PR.build_raster(normal, points, cell, margin, _MAX_CELLS)
+    raster = PR.build_raster(normal, points, cell, margin, _MAX_CELLS, along)
     flags = PR.classify(raster, maps.surface_with, maps.distance_with, maps.surface_without,
                         maps.distance_without, maps.hidden, surface, _DEPTH_TOLERANCE)
     values, weight = PR.sample_panorama(raster, rho_image, rho_valid & (maps.surface_with == surface))

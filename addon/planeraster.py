@@ -39,22 +39,48 @@ class PlaneRaster:
         return rel @ self.v / self.cell - 0.5, rel @ self.u / self.cell - 0.5
 
 
-def plane_axes(normal: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Two unit axes spanning the plane: on a floor or ceiling u follows x, on a wall u is
-    horizontal, so tile lines along the room's axes run along the raster's rows or columns."""
+def plane_axes(normal: np.ndarray, along: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Two unit axes spanning the plane. On a wall u is horizontal; on a floor or ceiling u
+    follows `along` (the surface's own edges, see `edge_direction`), else the frame's x, so that
+    tile and plank lines along the room's walls run along the raster's rows or columns."""
     n = np.asarray(normal, dtype=np.float64) / np.linalg.norm(normal)
-    a = np.array([1.0, 0.0, 0.0]) if abs(n[2]) > 0.9 else np.cross([0.0, 0.0, 1.0], n)
+    if abs(n[2]) > 0.9:
+        a = np.array([1.0, 0.0, 0.0]) if along is None else np.asarray(along, dtype=np.float64)
+    else:
+        a = np.cross([0.0, 0.0, 1.0], n)
     u = a - (a @ n) * n
+    if np.linalg.norm(u) < 1e-9:
+        u = np.array([1.0, 0.0, 0.0]) - n[0] * n
     u /= np.linalg.norm(u)
     return u, np.cross(n, u)
 
 
+def edge_direction(triangles: np.ndarray, normal: np.ndarray) -> np.ndarray:
+    """(3,) the dominant direction, modulo a right angle, of the edges of a planar surface's
+    triangles (T, 3, 3): the orientation (1-degree bins) that most edge length shares, refined
+    over the edges within a degree of it. A floor's outline runs along the room's walls even
+    when the frame (a rotated world) does not, and its quads' diagonals lose the vote."""
+    e1, e2 = plane_axes(normal)
+    edges = (np.roll(triangles, -1, axis=1) - triangles).reshape(-1, 3)
+    x, y = edges @ e1, edges @ e2
+    length = np.hypot(x, y)
+    folded = np.mod(np.degrees(np.arctan2(y, x)), 90.0)  # edges at right angles share a value
+    votes = np.bincount(np.minimum(folded.astype(np.int64), 89), weights=length, minlength=90)
+    # Each bin with its neighbours (circularly): edges at 19.99 and 20.01 degrees vote together.
+    votes = votes + np.roll(votes, 1) + np.roll(votes, -1)
+    peak = float(np.argmax(votes)) + 0.5
+    offset = (folded - peak + 45.0) % 90.0 - 45.0
+    near = np.abs(offset) <= 1.5
+    angle = np.radians(peak + (np.average(offset[near], weights=length[near]) if length[near].sum() > 0 else 0.0))
+    return np.cos(angle) * e1 + np.sin(angle) * e2
+
+
 def build_raster(normal: np.ndarray, hidden_points: np.ndarray, cell: float, margin: float,
-                 max_cells: int) -> PlaneRaster:
+                 max_cells: int, along: np.ndarray | None = None) -> PlaneRaster:
     """A raster over the plane of `hidden_points` (N, 3) covering them and `margin` times their
-    extent on every side (the exemplar around the hole); `cell` grows if the raster would
-    exceed `max_cells` cells."""
-    u, v = plane_axes(normal)
+    extent on every side (the exemplar around the hole), its axes as `plane_axes(normal, along)`;
+    `cell` grows if the raster would exceed `max_cells` cells."""
+    u, v = plane_axes(normal, along)
     pu, pv = hidden_points @ u, hidden_points @ v
     extent = max(float(np.ptp(pu)), float(np.ptp(pv)), cell)
     pad = margin * extent

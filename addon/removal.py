@@ -26,6 +26,7 @@ from .formfactor import paired_point_to_triangle
 from .geometry import Geometry, boundary_objects, build_geometry, plane_of_object, surface_keys
 from .hiddenfill import PanoramaMaps, fill_surface
 from .patches import Lattice, build_lattice, levels_for_count, levels_for_size, triangle_samples
+from .planeraster import edge_direction
 from .planner import neighbourhood, shadow_volume
 from .quality import Params
 from .radiosity import LUMA, RHO_MAX, fill_unseen, patch_radiosity, propagate, recover_reflectance
@@ -586,9 +587,11 @@ class _Removal:
                 rho[sel] = level_rho
                 show(change())
 
-            got = fill_surface(maps, rho_image, valid, int(key), geo.normals[tri[sel[0]]], points[sel], cell,
+            normal = geo.normals[tri[sel[0]]]
+            along = edge_direction(geo.triangles[keys == key], normal)
+            got = fill_surface(maps, rho_image, valid, int(key), normal, points[sel], cell,
                                prm.exemplar_margin, synth, seed=prm.seed, cancel=self.cancel,
-                               progress=None if show is None else level_shown)
+                               progress=None if show is None else level_shown, along=along)
             name = geo.object_names[geo.tri_object[tri[sel[0]]]]
             if got.known_cells:
                 rho[sel] = got.rho

@@ -104,3 +104,20 @@ def test_raster_lookup_is_bilinear():
     pts = np.array([[0.05 + 0.1 * 1.25, 0.05 + 0.1 * 2.5, 0.0], [0.0, 0.0, 0.0], [9.0, 9.0, 0.0]])
     got = PR.sample_raster(r, image, pts)[:, 0]
     assert np.allclose(got, [3 * 2.5 + 1.25, 0.0, 3 * 3 + 4])  # inside, clamped low, clamped high
+
+
+@pytest.mark.parametrize("degrees", [0.0, 20.0, 70.0, -35.0])
+def test_edge_direction_follows_a_rotated_floor_not_its_diagonal(degrees):
+    # A 5 x 3 m floor as two triangles, turned about the vertical: its sides vote for its
+    # orientation (modulo 90 degrees); the diagonal each triangle shares must not tilt it.
+    a = np.radians(degrees)
+    rot = np.array([[np.cos(a), -np.sin(a), 0.0], [np.sin(a), np.cos(a), 0.0], [0.0, 0.0, 1.0]])
+    corners = np.array([[0, 0, 0], [5, 0, 0], [5, 3, 0], [0, 3, 0]], dtype=float) @ rot.T
+    triangles = np.stack([corners[[0, 1, 2]], corners[[0, 2, 3]]])
+    got = PR.edge_direction(triangles, np.array([0.0, 0.0, 1.0]))
+    angle = np.degrees(np.arctan2(got[1], got[0]))
+    assert abs((angle - degrees + 45.0) % 90.0 - 45.0) < 0.01
+    u, v = PR.plane_axes(np.array([0.0, 0.0, 1.0]), got)
+    # The raster's columns run along one of the floor's sides.
+    assert abs(u @ v) < 1e-12
+    assert max(abs(u @ rot[:, 0]), abs(u @ rot[:, 1])) == pytest.approx(1.0, abs=1e-9)
