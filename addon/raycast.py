@@ -43,8 +43,11 @@ def _uv_window(tris: np.ndarray, width: int, height: int) -> tuple[np.ndarray, .
     pts = np.concatenate(edges, axis=1)
     u, v = latlong.direction_to_uv(pts)
     rows = (1.0 - v) * height
-    row0 = np.clip(np.floor(rows.min(axis=1)) - 2, 0, height - 1).astype(np.int64)
-    row1 = np.clip(np.ceil(rows.max(axis=1)) + 2, 0, height - 1).astype(np.int64)
+    # An edge passing close to a pole reaches its highest (lowest) elevation between samples,
+    # rows away from the samples' own: take each edge's exact extremes as well.
+    extreme = _edge_extreme_rows(tris, height)
+    row0 = np.clip(np.floor(np.minimum(rows.min(axis=1), extreme.min(axis=1))) - 2, 0, height - 1).astype(np.int64)
+    row1 = np.clip(np.ceil(np.maximum(rows.max(axis=1), extreme.max(axis=1))) + 2, 0, height - 1).astype(np.int64)
     # The u span is the circle minus its largest gap between samples (handles the seam).
     us = np.sort(u, axis=1)
     gaps = np.diff(np.concatenate([us, us[:, :1] + 1.0], axis=1), axis=1)
@@ -62,6 +65,26 @@ def _uv_window(tris: np.ndarray, width: int, height: int) -> tuple[np.ndarray, .
         cols = np.where(inside, width, cols)
     cols = np.minimum(cols, width)
     return row0, row1 - row0 + 1, col0, cols
+
+
+def _edge_extreme_rows(tris: np.ndarray, height: int) -> np.ndarray:
+    """(T, 3) the panorama row (continuous) of each edge's interior extreme of elevation.
+
+    Along p(t) = a + t (b - a) the elevation z / |p| has one stationary point, where
+    t = (a_z a.e - e_z |a|^2) / (e_z a.e - a_z |e|^2); clipped to the edge, it is an endpoint
+    when the extreme lies outside."""
+    a = tris
+    e = np.roll(tris, -1, axis=1) - tris
+    ae = np.einsum("tkc,tkc->tk", a, e)
+    aa = np.einsum("tkc,tkc->tk", a, a)
+    ee = np.einsum("tkc,tkc->tk", e, e)
+    num = a[..., 2] * ae - e[..., 2] * aa
+    den = e[..., 2] * ae - a[..., 2] * ee
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = np.where(np.abs(den) > 0.0, num / den, 0.0)
+    p = a + np.clip(np.nan_to_num(t), 0.0, 1.0)[..., None] * e
+    z = p[..., 2] / np.maximum(np.linalg.norm(p, axis=2), 1e-300)
+    return np.arccos(np.clip(z, -1.0, 1.0)) / np.pi * height
 
 
 def _edge_normals(tris: np.ndarray) -> np.ndarray:

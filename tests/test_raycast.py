@@ -1,5 +1,6 @@
 """Panorama ray casting and segment occlusion against analytic geometry."""
 import numpy as np
+import pytest
 
 from addon.raycast import Occluders, trace_panorama
 
@@ -54,3 +55,14 @@ def test_segments_blocked_by_a_box_match_a_dense_check():
     assert exact.sum() > 1000 and (got == exact).all()
     # endpoints on the surface do not block themselves
     assert not occ.blocked(np.array([[0.5, 0.5, 1.0]]), np.array([[0.5, 0.5, 3.0]]))[0]
+
+
+@pytest.mark.parametrize("offset", [0.02, 0.05, 0.11])
+def test_an_edge_passing_close_to_a_pole_still_covers_the_rows_beside_it(offset):
+    # The ceiling's and floor's diagonals pass `offset` m beside the probe's vertical: between
+    # the edge samples the edge climbs rows closer to the pole than any sample, and those rows
+    # must still be hit (they were once left empty, a ring of "open room" pixels).
+    room = box([-2.0 + offset, -2.0, -1.5], [2.0 + offset, 2.0, 1.2])
+    for width in (256, 1024):
+        hits = trace_panorama(room, width, width // 2)
+        assert (hits.tri >= 0).all(), f"{(hits.tri < 0).sum()} pixels missed at {width}"
