@@ -19,6 +19,7 @@ import shutil
 import tempfile
 import time
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import bpy
 import numpy as np
@@ -26,6 +27,9 @@ import numpy as np
 from ..addon.errors import Cancelled, DimredError
 from ..addon.worker import Worker
 from . import world_layer
+
+if TYPE_CHECKING:  # the engine is imported only when a run starts
+    from ..addon.removal_job import RemovalOutcome, RemovalRequest
 
 PREVIEW_IMAGE = "DimRed Preview"
 # Seconds a cancelled worker may take to notice; the engine checks far more often than this.
@@ -94,7 +98,7 @@ class RemovalSession:
     scene_name: str
     world_name: str
     object_name: str
-    request: object  # addon.removal_job.RemovalRequest
+    request: "RemovalRequest"
     pack: bool
     relative: bool  # the output folder is given relative to the .blend
     temporary_folder: str = ""
@@ -237,7 +241,7 @@ class RemovalSession:
         world.update_tag()
         _redraw(context)
 
-    def _apply(self, context: bpy.types.Context, outcome) -> bool:
+    def _apply(self, context: bpy.types.Context, outcome: "RemovalOutcome") -> bool:
         world = self._world()
         scene = bpy.data.scenes.get(self.scene_name)
         if world is None or scene is None:
