@@ -49,8 +49,6 @@ def plane_axes(normal: np.ndarray, along: np.ndarray | None = None) -> tuple[np.
     else:
         a = np.cross([0.0, 0.0, 1.0], n)
     u = a - (a @ n) * n
-    if np.linalg.norm(u) < 1e-9:
-        u = np.array([1.0, 0.0, 0.0]) - n[0] * n
     u /= np.linalg.norm(u)
     return u, np.cross(n, u)
 

@@ -55,10 +55,8 @@ class Staged:
 
 @dataclass
 class RemovalOutcome:
-    own: np.ndarray  # (H, W, 3) this removal's difference
-    layer: np.ndarray  # (H, W, 3) base + own: what the world layer adds to the HDRI
     report: dict
-    staged: Staged
+    staged: Staged  # this removal's own difference and the layer (base + own), to commit
 
 
 def loaded(scene: SceneData) -> SceneData:
@@ -117,4 +115,4 @@ def run(
     except BaseException:
         staged.discard()
         raise
-    return RemovalOutcome(own=result.difference, layer=layer, report=result.report, staged=staged)
+    return RemovalOutcome(report=result.report, staged=staged)

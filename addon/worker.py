@@ -8,7 +8,6 @@ preview is kept, so a slow main thread never piles up images.
 from __future__ import annotations
 
 import threading
-import time
 from dataclasses import dataclass
 from typing import Any, Callable, Generic, TypeVar
 
@@ -48,10 +47,8 @@ class Worker(Generic[T]):
         self._outcome: tuple[T | None, BaseException | None] | None = None
         self._delivered = False
         self._thread = threading.Thread(target=self._run, name=name, daemon=True)
-        self.started_at = 0.0
 
     def start(self) -> "Worker[T]":
-        self.started_at = time.perf_counter()
         self._thread.start()
         return self
 

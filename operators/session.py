@@ -109,7 +109,6 @@ class RemovalSession:
     fraction: float = 0.0
     message: str = ""  # the result's one line (info or error)
     ok: bool = False
-    report: dict = field(default_factory=dict)
     warnings: list[str] = field(default_factory=list)  # about the removal order, added to the report
     tick_seconds: list[float] = field(default_factory=list)  # main-thread time per tick
 
@@ -224,16 +223,16 @@ class RemovalSession:
         world = self._world()
         if world is None:
             return
-        image = bpy.data.images.get(PREVIEW_IMAGE)
         size = _image_size(world)
+        if len(pixels) != size[0] * size[1] * 4:
+            return  # the world's image was swapped for another size while the run went on
+        image = bpy.data.images.get(PREVIEW_IMAGE)
         if image is not None and tuple(image.size) != size:
             bpy.data.images.remove(image)
             image = None
         if image is None:
             image = bpy.data.images.new(PREVIEW_IMAGE, size[0], size[1], alpha=True, float_buffer=True)
             image.colorspace_settings.name = world_layer.DIFFERENCE_COLORSPACE
-        if len(pixels) != size[0] * size[1] * 4:
-            return
         image.pixels.foreach_set(pixels)
         image.update()
         if world_layer.layer_image(world) is not image:
@@ -267,7 +266,7 @@ class RemovalSession:
         report.setdefault("warnings", []).extend(self.warnings)
         report["layer"] = [r.object_name for r in settings.removals]
         settings.last_report = json.dumps(report)
-        self.report, self.ok = report, True
+        self.ok = True
         where = "packed into the .blend" if self.pack else f"wrote {request.layer_path}"
         self.message = f"Removed '{self.object_name}': {report_summary(report)}; {where}"
         _redraw(context)
@@ -276,8 +275,8 @@ class RemovalSession:
     def _fail(self, context: bpy.types.Context | None, message: str) -> bool:
         """Put the world back as it was before this session and keep `message`."""
         world = self._world()
-        if world is not None and world_layer.layer_image(world) is not None \
-                and world_layer.layer_image(world).name == PREVIEW_IMAGE:
+        shown = world_layer.layer_image(world) if world is not None else None
+        if shown is not None and shown.name == PREVIEW_IMAGE:
             previous = bpy.data.images.get(self.previous_layer) if self.previous_layer else None
             if previous is not None:
                 world_layer.add_layer(world, previous)
