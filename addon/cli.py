@@ -1,7 +1,8 @@
-"""The command line: remove an object from a scene's panorama without Blender's interface.
+"""The command line: remove or move an object in a scene's panorama without Blender's interface.
 
     python -m addon.cli remove SCENE.blend --object NAME --out DIR [options]
-    blender -b SCENE.blend -c dimred remove --object NAME --out DIR [options]
+    python -m addon.cli relocate SCENE.blend --object NAME --yaw DEG --distance-scale S --out DIR [options]
+    blender -b SCENE.blend -c dimred remove|relocate ... (the same arguments)
 
 Both run `run_cli`; inside Blender the .blend is already open, so SCENE.blend is optional.
 Bad input gets one line `dimred: error: ...` on stderr, exit code 2, and nothing on disk.
@@ -55,7 +56,23 @@ ProbeCenter, else the world origin.
 
 examples:
   python -m addon.cli remove room.blend --object Box --out out/
-  blender -b room.blend -c dimred remove --object Box --plane Floor --quality final --out out/"""
+  blender -b room.blend -c dimred remove --object Box --plane Floor --quality final --out out/
+  python -m addon.cli relocate room.blend --object Box --yaw 40 --distance-scale 1.3 --out out/"""
+
+_RELOCATE_DESCRIPTION = """\
+Move a real object elsewhere in the HDR panorama under the fixed-view constraint: the
+panorama shows it from one side only, so it may only turn about the vertical axis through the
+probe centre (its position and its orientation by the same angle, --yaw) and change its
+horizontal distance from that axis (--distance-scale), standing on the surface it stands on.
+It is removed at the old place (shadow, reflected light, the floor behind it synthesised) and
+inserted at the new one (its appearance from the panorama relit there, hiding what is behind
+it, its new shadow and reflected light). A move off its support surface, through a wall or
+another object, or with a distance factor <= 0 is refused. Writes the same files as remove:
+
+  difference.exr   what to add to the panorama (RGB float32, the panorama's size)
+  edited.exr       the panorama plus the difference
+  report.json      as for remove, plus "relocation": the move, its world matrix, the
+                   change of view elevation (degrees) and the insertion's convergence"""
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -101,37 +118,71 @@ def build_parser(blend_already_loaded: bool) -> argparse.ArgumentParser:
         epilog=_EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
+    _scene_arguments(remove, blend_already_loaded, "the mesh object to remove")
+    remove.set_defaults(run=_remove)
+    relocate = commands.add_parser(
+        "relocate",
+        help="move an object elsewhere in the panorama (fixed-view constraint)",
+        description=_RELOCATE_DESCRIPTION,
+        epilog=_EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    _scene_arguments(relocate, blend_already_loaded, "the mesh object to move")
+    relocate.add_argument("--yaw", type=float, default=0.0, metavar="DEG",
+                          help="degrees to turn the object about the vertical axis through the probe centre "
+                               "(counter-clockwise seen from above; its orientation turns by the same angle)")
+    relocate.add_argument("--distance-scale", type=float, default=1.0, metavar="S",
+                          help="factor on the object's horizontal distance from that axis (> 0; default 1)")
+    relocate.set_defaults(run=_relocate)
+    return parser
+
+
+def _scene_arguments(parser: argparse.ArgumentParser, blend_already_loaded: bool, object_help: str) -> None:
     blend_help = "the scene (.blend) to read"
     if blend_already_loaded:
-        remove.add_argument("blend", nargs="?", metavar="SCENE.blend", help=blend_help + " (default: the open file)")
+        parser.add_argument("blend", nargs="?", metavar="SCENE.blend", help=blend_help + " (default: the open file)")
     else:
-        remove.add_argument("blend", metavar="SCENE.blend", help=blend_help)
-    remove.add_argument("--object", required=True, metavar="NAME", help="the mesh object to remove")
-    remove.add_argument(
+        parser.add_argument("blend", metavar="SCENE.blend", help=blend_help)
+    parser.add_argument("--object", required=True, metavar="NAME", help=object_help)
+    parser.add_argument(
         "--plane",
         action="append",
         default=[],
         metavar="NAME",
         help="a mesh surface to edit (repeatable); without it the surfaces the removal reveals or relights are found",
     )
-    remove.add_argument("--out", required=True, metavar="DIR", help="output folder (created if needed)")
-    remove.add_argument("--quality", choices=QUALITIES, default="balanced", help=_QUALITY_HELP)
-    remove.add_argument(
+    parser.add_argument("--out", required=True, metavar="DIR", help="output folder (created if needed)")
+    parser.add_argument("--quality", choices=QUALITIES, default="balanced", help=_QUALITY_HELP)
+    parser.add_argument(
         "--center",
         nargs=3,
         type=float,
         metavar=("X", "Y", "Z"),
         help="probe centre in world space, overriding the scene's",
     )
-    remove.add_argument("--verbose", action="store_true", help="print progress and notes on stderr")
-    remove.set_defaults(run=_remove)
-    return parser
+    parser.add_argument("--verbose", action="store_true", help="print progress and notes on stderr")
 
 
 def _remove(args: argparse.Namespace) -> int:
+    from . import pipeline
+
+    return _run(args, "removed", lambda scene, **kw: pipeline.remove_object(scene, args.object, **kw))
+
+
+def _relocate(args: argparse.Namespace) -> int:
+    from . import pipeline
+    from .fixedview import Move, check_move
+
+    move = Move(args.yaw, args.distance_scale)
+    # Before the scene is read: a request no placement satisfies needs no .blend.
+    check_move(move)
+    return _run(args, "moved", lambda scene, **kw: pipeline.relocate_object(scene, args.object, move, **kw))
+
+
+def _run(args: argparse.Namespace, done: str, compute: Callable[..., object]) -> int:
     import bpy
 
-    from . import bridge, pipeline
+    from . import bridge
 
     started = time.perf_counter()
     out = os.path.abspath(args.out)
@@ -145,16 +196,15 @@ def _remove(args: argparse.Namespace) -> int:
     bridge.check_object(scene, args.object)
     for plane in args.plane:
         if plane == args.object:
-            raise DimredError(f"'{plane}' is the object to remove; it cannot also be a --plane")
+            raise DimredError(f"'{plane}' is the object itself; it cannot also be a --plane")
         bridge.check_object(scene, plane, purpose="used as a --plane")
     scene_data = bridge.read_scene(scene, center=args.center)
     loaded = time.perf_counter()
     if args.verbose:
         for note in scene_data.notes:
             print(f"{PROG}: note: {note}", file=sys.stderr)
-    result = pipeline.remove_object(
+    result = compute(
         scene_data,
-        args.object,
         planes=list(args.plane),
         quality=args.quality,
         progress=_print_progress if args.verbose else None,
@@ -168,7 +218,7 @@ def _remove(args: argparse.Namespace) -> int:
     mask = result.hidden_mask if report.get("hidden_region_filled") is False else None
     write_outputs(out, images, mask, report)
     total = time.perf_counter() - started
-    print(f"{PROG}: removed '{args.object}' in {total:.1f} s; wrote {out}", flush=True)
+    print(f"{PROG}: {done} '{args.object}' in {total:.1f} s; wrote {out}", flush=True)
     for warning in report.get("warnings", []):
         print(f"{PROG}: warning: {warning}", file=sys.stderr)
     return 0

@@ -130,7 +130,8 @@ def move_between(center: np.ndarray, reference: np.ndarray, before: np.ndarray, 
     orbit = math.degrees(math.atan2(h0[0] * h1[1] - h0[1] * h1[0], h0 @ h1))
     if abs((turn - orbit + 180.0) % 360.0 - 180.0) > _TOLERANCE_DEG:
         raise DimredError(
-            f"the object turns by {turn:.1f} degrees but goes round the probe centre by {orbit:.1f}: under the "
+            f"the object turns by {round(turn, 1) + 0.0} degrees but goes round the probe centre by "
+            f"{round(orbit, 1) + 0.0}: under the "
             "fixed-view constraint both are the same angle, so the photographed side keeps facing the probe"
         )
     return Move(yaw=orbit, distance_scale=r1 / r0)

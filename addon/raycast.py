@@ -297,13 +297,11 @@ def _morton(q: np.ndarray) -> np.ndarray:
 
 
 
-def first_hits(origins: np.ndarray, directions: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(N,) the first of `triangles` (T, 3, 3) each ray origin + t direction (t > 0) hits, -1
-    for none, and its t (inf for none). Brute force over all triangles: for a few rays."""
+def _ray_distances(origins: np.ndarray, directions: np.ndarray, triangles: np.ndarray):
+    """Yield (first triangle index, (N, n) t of each ray at n triangles, inf where missed),
+    chunk by chunk over all triangles: brute force, for a few rays."""
     o = np.asarray(origins, dtype=np.float64)
     d = np.asarray(directions, dtype=np.float64)
-    best = np.full(len(o), np.inf)
-    index = np.full(len(o), -1, dtype=np.int64)
     v0, e1, e2 = triangles[:, 0], triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0]
     per = max(1, _PAIR_CHUNK // max(len(o), 1))
     for j0 in range(0, len(triangles), per):
@@ -317,10 +315,25 @@ def first_hits(origins: np.ndarray, directions: np.ndarray, triangles: np.ndarra
         q = np.cross(t_vec, e1[None, sl])
         v = np.einsum("nc,ntc->nt", d, q) * inv
         t = np.einsum("tc,ntc->nt", e2[sl], q) * inv
-        hit = ok & (u >= 0.0) & (v >= 0.0) & (u + v <= 1.0) & (t > 0.0)
-        t = np.where(hit, t, np.inf)
+        yield j0, np.where(ok & (u >= 0.0) & (v >= 0.0) & (u + v <= 1.0) & (t > 0.0), t, np.inf)
+
+
+def first_hits(origins: np.ndarray, directions: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(N,) the first of `triangles` (T, 3, 3) each ray origin + t direction (t > 0) hits, -1
+    for none, and its t (inf for none)."""
+    best = np.full(len(origins), np.inf)
+    index = np.full(len(origins), -1, dtype=np.int64)
+    for j0, t in _ray_distances(origins, directions, triangles):
         k = t.argmin(axis=1)
-        tk = t[np.arange(len(o)), k]
+        tk = t[np.arange(len(t)), k]
         closer = tk < best
         best[closer], index[closer] = tk[closer], j0 + k[closer]
     return index, best
+
+
+def crossings(origins: np.ndarray, directions: np.ndarray, triangles: np.ndarray) -> np.ndarray:
+    """(N,) how many of `triangles` each ray crosses (odd: the origin is inside a closed mesh)."""
+    count = np.zeros(len(origins), dtype=np.int64)
+    for _, t in _ray_distances(origins, directions, triangles):
+        count += np.isfinite(t).sum(axis=1)
+    return count

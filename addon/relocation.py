@@ -26,8 +26,9 @@ from .errors import DimredError
 from .fixedview import Move
 from .quality import Params
 from .radiosity import LUMA, RHO_MAX
-from .raycast import Occluders, first_hits
-from .removal import RemovalResult, Solution, finish, solve
+from .raycast import Occluders, crossings, first_hits
+from .geometry import Geometry
+from .removal import RemovalResult, Solution, _Removal, finish, solve
 from .report import Report
 from .scene import SceneData
 
@@ -104,31 +105,36 @@ def place(scene: SceneData, target: int, move: Move) -> Placement:
 
 def _collisions(before: np.ndarray, after: np.ndarray, others: np.ndarray, other_ids: np.ndarray,
                 support: np.ndarray, eps: float) -> list[int]:
-    """Objects (not the support) that the moved object's edges cross and its old edges did not
-    (a model that already touched a wall a little is not refused for that)."""
+    """Objects (not the support) that the moved object cuts (its edges cross them) or sits in
+    (its centre inside their closed mesh), where its old place did not (a model that already
+    touched a wall a little is not refused for that)."""
     found = []
+    # Not straight up: a box's centre lies under the diagonal its top face's two triangles
+    # share, and a ray along that edge would count the face twice.
+    up = np.array([[0.0123, 0.0271, 1.0]])
     for k in np.unique(other_ids):
         if k in support:
             continue
-        occ = Occluders(others[other_ids == k], other_ids[other_ids == k], eps)
+        tris = others[other_ids == k]
+        occ = Occluders(tris, other_ids[other_ids == k], eps)
 
-        def crosses(tris: np.ndarray) -> bool:
-            a = tris.reshape(-1, 3)
-            b = np.roll(tris, -1, axis=1).reshape(-1, 3)
-            return bool(occ.blocked(a, b).any())
+        def collides(obj: np.ndarray) -> bool:
+            a = obj.reshape(-1, 3)
+            b = np.roll(obj, -1, axis=1).reshape(-1, 3)
+            inside = crossings(fixedview.reference_point(obj)[None], up, tris)[0] % 2 == 1
+            return bool(inside or occ.blocked(a, b).any())
 
-        if crosses(after) and not crosses(before):
+        if collides(after) and not collides(before):
             found.append(int(k))
     return found
 
 
-def _map_rows(old: Solution, new: Solution, tri_new: np.ndarray) -> np.ndarray:
+def _map_rows(old: Geometry, new: Geometry, tri_new: np.ndarray) -> np.ndarray:
     """Triangle indices of the old geometry for triangles of the new one (the same rows of the
     scene's triangle list; -1 where the old geometry dropped the row)."""
-    n = int(max(old.job.geo.source.max(), new.job.geo.source.max())) + 1
-    index = np.full(n, -1, dtype=np.int64)
-    index[old.job.geo.source] = np.arange(len(old.job.geo.source))
-    return index[new.job.geo.source[tri_new]]
+    index = np.full(int(max(old.source.max(), new.source.max())) + 1, -1, dtype=np.int64)
+    index[old.source] = np.arange(len(old.source))
+    return index[new.source[tri_new]]
 
 
 def _photographed(old: Solution, photo: np.ndarray, tri: np.ndarray, bary: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -143,8 +149,7 @@ def _photographed(old: Solution, photo: np.ndarray, tri: np.ndarray, bary: np.nd
     x = u * job.width - 0.5
     y = (1.0 - v) * job.height - 0.5
     x0, y0 = np.floor(x).astype(np.int64), np.floor(y).astype(np.int64)
-    on_object = job.geo.tri_object[np.maximum(job.hits.tri, 0)] == job.target
-    on_object &= job.hits.tri >= 0
+    on_object = (job.hits.tri >= 0) & (job.geo.tri_object[np.maximum(job.hits.tri, 0)] == job.target)
     total = np.zeros((len(points), 3))
     weight = np.zeros(len(points))
     for dy in (0, 1):
@@ -160,15 +165,25 @@ def _photographed(old: Solution, photo: np.ndarray, tri: np.ndarray, bary: np.nd
     return np.where(seen[:, None], total / np.maximum(weight, 1e-300)[:, None], 0.0), seen
 
 
-def _appearance(old: Solution, new: Solution, photo: np.ndarray, rep: Report) -> tuple[np.ndarray, np.ndarray]:
-    """Flat pixel indices of the object at the new place and their radiance (N, 3): the
-    reflectance it showed at the old place lit by the irradiance at the new one."""
-    job = new.job
+@dataclass
+class _Carried:
+    """The object's pixels at the new place and what the old place tells about them."""
+
+    pix: np.ndarray  # (N,) flat pixel indices showing the object at the new place
+    tri: np.ndarray  # (N,) its triangles there (new geometry)
+    bary: np.ndarray  # (N, 2)
+    rho: np.ndarray  # (N, 3) its reflectance, from the photograph and the irradiance at the old place
+    photographed: np.ndarray  # (N, 3) the photograph's radiance there (the first guess, before relighting)
+
+
+def _carry(old: Solution, job: _Removal, photo: np.ndarray, rep: Report) -> _Carried:
+    """Map the object's pixels at the new place (`job`, traced) to its old place: radiance,
+    reflectance, and a guard count of the points the photograph does not show."""
     on = job.obj_h == job.target
     pix = job.hp[on]
     tri_new = job.tri_h[on]
     bary = job.hits.bary.reshape(-1, 2)[pix]
-    tri_old = _map_rows(old, new, tri_new)
+    tri_old = _map_rows(old.job.geo, job.geo, tri_new)
     known = tri_old >= 0
     radiance = np.zeros((len(pix), 3))
     seen = np.zeros(len(pix), dtype=bool)
@@ -176,7 +191,6 @@ def _appearance(old: Solution, new: Solution, photo: np.ndarray, rep: Report) ->
     if known.any():
         radiance[known], seen[known] = _photographed(old, photo, tri_old[known], bary[known])
         e_old[known] = old.irradiance(tri_old[known], bary[known])
-    e_new = new.irradiance(tri_new, bary)
     y_old = e_old @ LUMA
     lit = seen & (y_old > 1e-3 * max(float(np.median(y_old[seen])) if seen.any() else 0.0, 1e-30))
     implied = np.pi * radiance[lit] / np.maximum(e_old[lit], 1e-30)
@@ -184,19 +198,19 @@ def _appearance(old: Solution, new: Solution, photo: np.ndarray, rep: Report) ->
     rho = np.zeros((len(pix), 3))
     rho[lit] = np.clip(implied, 0.0, RHO_MAX)
     if lit.any():
-        fallback = np.median(rho[lit], axis=0)
+        rho[~lit] = np.median(rho[lit], axis=0)
+        radiance[~lit] = np.median(radiance[lit], axis=0)
     else:
-        on_object = old.room.senders.on_removed
-        fallback = np.median(old.room.rho[on_object], axis=0)
+        rho[:] = np.median(old.room.rho[old.room.senders.on_removed], axis=0)
+        radiance[:] = rho * np.median(e_old, axis=0) / np.pi
         rep.warn("the probe did not see the object well enough to take its appearance from the panorama: "
                  "it is shown with its estimated mean reflectance")
-    rho[~lit] = fallback
     unseen = int((~lit).sum())
     if unseen:
-        # Points the photograph does not show: a nearer object is seen more from above, or its
-        # own self-shadow was too dark to measure.
+        # Points the photograph does not show (a nearer object is seen more from above) or
+        # shows too dark to measure (its own deep shadow) take the object's median.
         rep.guard("object_pixels_without_photograph", unseen)
-    return pix, rho * e_new / np.pi
+    return _Carried(pix, tri_new, bary, rho, radiance)
 
 
 def _scaled(progress: Callable[[str, float], None] | None, lo: float, hi: float, prefix: str):
@@ -239,10 +253,21 @@ def relocate(
     moved_scene = replace(scene, triangles=placement.triangles)
     insertion = Report()
     residuals = []
+    carried: list[_Carried] = []
+
+    def first_guess(job) -> None:
+        # The object's patches send light too: before the first pass reads the panorama as
+        # radiosity, the object is put at its new place as photographed.
+        carried.append(_carry(old, job, photo, insertion))
+        image = job.hdri.reshape(-1, 3).copy()
+        image[carried[0].pix] = carried[0].photographed
+        job.hdri = image.reshape(job.hdri.shape)
+
     for k in range(passes):
         step = Report(_scaled(progress, share * (k + 1), share * (k + 2), f"insertion {k + 1}/{passes}: "), stages=7)
         image = current.reshape(photo.shape).astype(np.float32)
-        new = solve(replace(moved_scene, hdri=image), object_name, planes, params, step, cancel)
+        new = solve(replace(moved_scene, hdri=image), object_name, planes, params, step, cancel,
+                    traced=None if carried else first_guess)
         with insertion.stage("insertion"):
             updated = without.copy()
             job = new.job
@@ -255,8 +280,8 @@ def relocate(
             wild = (ratio > _RATIO_MAX).any(axis=1)
             ratio = np.clip(ratio, 0.0, _RATIO_MAX)
             updated[job.hp[room]] = without[job.hp[room]] * ratio
-            pix, radiance = _appearance(old, new, photo, insertion)
-            updated[pix] = radiance
+            obj = carried[0]
+            updated[obj.pix] = obj.rho * new.irradiance(obj.tri, obj.bary) / np.pi
             y_new, y_without = updated @ LUMA, without @ LUMA
             # The share of the insertion's change that this pass still changed: how far from its fixed point.
             residuals.append(float(np.abs(y_new - current @ LUMA).sum() / max(float(np.abs(y_new - y_without).sum()), 1e-30)))
@@ -267,7 +292,7 @@ def relocate(
     insertion.guard("insertion_ratio_clamped_pixels", int(wild.sum()))
     difference = (current.reshape(photo.shape) - photo).astype(np.float32)
     hidden = removed.hidden_mask.ravel().copy()
-    hidden[pix] = True
+    hidden[carried[0].pix] = True
     done = insertion.as_dict()
     report["seconds"] = {**{f"removal_{k}": v for k, v in report["seconds"].items() if k != "total"},
                          **{f"insertion_{k}": v for k, v in last["seconds"].items() if k != "total"},
@@ -278,7 +303,7 @@ def relocate(
     report["guards"].update(done["guards"])
     report["relocation"] = dict(
         yaw=move.yaw, distance_scale=move.distance_scale, elevation_change=round(placement.elevation_change, 3),
-        matrix=placement.matrix.tolist(), support=placement.support, object_pixels=int(len(pix)),
+        matrix=placement.matrix.tolist(), support=placement.support, object_pixels=int(len(carried[0].pix)),
         insertion_passes=passes, residuals=[round(r, 5) for r in residuals],
     )
     if abs(placement.elevation_change) > 10.0:

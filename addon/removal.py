@@ -646,9 +646,10 @@ class Solution:
 
 
 def solve(scene: SceneData, object_name: str, planes: list[str] | tuple[str, ...], params: Params, rep: Report,
-          cancel: Callable[[], bool] | None = None) -> Solution:
+          cancel: Callable[[], bool] | None = None, traced: Callable[[_Removal], None] | None = None) -> Solution:
     """Every stage of the removal up to the new irradiance of each pixel (DESIGN 3, steps 1-5
-    and 8); the stages are timed in `rep`."""
+    and 8); the stages are timed in `rep`. `traced(job)` is called once the pixels are traced,
+    before the panorama is read as radiosity (it may change `job.hdri`)."""
     check = _cancel_check(cancel)
     if object_name not in scene.object_names:
         raise DimredError(f"no mesh object named '{object_name}' among the scene's proxy geometry")
@@ -670,6 +671,8 @@ def solve(scene: SceneData, object_name: str, planes: list[str] | tuple[str, ...
     job.geometry(geo)
     with rep.stage("trace"):
         job.trace()
+    if traced is not None:
+        traced(job)
     check()
     with rep.stage("occluders"):
         job.occluders()

@@ -181,3 +181,24 @@ def hidden_region_scores(input: np.ndarray, edit: np.ndarray, truth: np.ndarray,
         "detail_ratio": float(high_pass(y_ed).std() / max(high_pass(y_tr).std(), 1e-30)),
         "object_shadow_ratio": float(np.abs(be - bt)[region].sum() / np.abs(bi - bt)[region].sum()),
     }
+
+
+def relocation_region(input: np.ndarray, moved: np.ndarray, empty: np.ndarray, old_mask: np.ndarray,
+                      new_mask: np.ndarray, margin: int = 2) -> np.ndarray:
+    """(H, W) bool: where a relocation must change the panorama. The object at its old place
+    and at its new one (masks dilated by `margin` px, the silhouettes' mixed pixels), and the
+    lighting each placement changes against the room without the object (`empty`): region A of
+    the input (`input` vs `empty`) and of the truth (`moved` vs `empty`)."""
+    return (dilate(old_mask, margin) | dilate(new_mask, margin)
+            | lighting_region(input, empty, old_mask, margin=margin)
+            | lighting_region(moved, empty, new_mask, margin=margin))
+
+
+def relocation_error_ratio(input: np.ndarray, edit: np.ndarray, moved: np.ndarray, region: np.ndarray) -> float:
+    """sum |Y_edit - Y_moved| / sum |Y_input - Y_moved| over `region` (blurred Y, as in
+    `lighting_error_ratio`), `moved` being the render with the object at its new place: 1 =
+    nothing moved, 0 = exactly the truth."""
+    if not region.any():
+        raise ValueError("the relocation region is empty")
+    yi, ye, yt = _blurred_y(input), _blurred_y(edit), _blurred_y(moved)
+    return float(np.abs(ye - yt)[region].sum() / np.abs(yi - yt)[region].sum())

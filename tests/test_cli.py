@@ -15,6 +15,7 @@ import pytest
 
 from addon import cli, exr, pipeline
 from addon.errors import DimredError
+from addon.fixedview import Move
 from addon.exr import read_exr, write_exr
 
 pytestmark = pytest.mark.usefixtures("fresh_blender")
@@ -286,3 +287,48 @@ def test_module_entry_point_reports_one_line(tmp_path):
     assert _lines(result.stderr) == [f"dimred: error: no such .blend file: {tmp_path / 'none.blend'}"]
     assert result.stdout == ""
     assert not (tmp_path / "o").exists()
+
+
+class FakeRelocation(FakeEngine):
+    """Stands in for `pipeline.relocate_object`; records the move too."""
+
+    def __call__(self, scene_data, object_name, move, planes=(), quality="balanced", progress=None):
+        result = super().__call__(scene_data, object_name, planes, quality, progress)
+        self.calls[-1]["move"] = move
+        return result
+
+
+@pytest.fixture
+def relocation(monkeypatch):
+    fake = FakeRelocation()
+    monkeypatch.setattr(pipeline, "relocate_object", fake)
+    return fake
+
+
+def test_relocate_passes_the_move_and_writes_the_three_files(room, relocation, tmp_path, capfd):
+    out = tmp_path / "moved"
+    code = cli.main(["relocate", str(room), "--object", "Box", "--yaw", "-40", "--distance-scale", "1.3",
+                     "--out", str(out)])
+    stdout, _ = capfd.readouterr()
+    assert code == 0
+    assert sorted(os.listdir(out)) == ["difference.exr", "edited.exr", "report.json"]
+    assert relocation.calls[0]["move"] == Move(-40.0, 1.3)
+    assert _lines(stdout)[0].startswith("dimred: moved 'Box' in ")
+
+
+def test_relocate_through_the_blender_command(room, relocation, tmp_path):
+    bpy.ops.wm.open_mainfile(filepath=str(room), load_ui=False)
+    out = tmp_path / "from-blender"
+    assert cli.blender_command(["relocate", "--object", "Box", "--yaw", "15", "--out", str(out)]) == 0
+    assert relocation.calls[0]["move"] == Move(15.0, 1.0)
+
+
+@pytest.mark.parametrize("scale, expected", [("0", "positive number, got 0.0"), ("-1.3", "got -1.3"),
+                                             ("nan", "got nan")])
+def test_relocate_refuses_a_distance_factor_not_above_zero(room, relocation, tmp_path, capfd, scale, expected):
+    out = tmp_path / "result"
+    code = cli.main(["relocate", str(room), "--object", "Box", "--yaw", "40", "--distance-scale", scale,
+                     "--out", str(out)])
+    _, stderr = capfd.readouterr()
+    _assert_failed_cleanly(code, stderr, expected, out, None)
+    assert not relocation.calls

@@ -142,3 +142,22 @@ def test_summary_keys() -> None:
     assert s["lighting_error_ratio"] == 0.0 and s["region_pixels"] > 0
     assert set(s) == {"region_pixels", "lighting_error_ratio", "noise_floor", "far_damage",
                       "bleeding_input", "bleeding_edit"}
+
+
+def test_relocation_region_and_ratio() -> None:
+    """The region holds both placements with their shadows; moving nothing scores 1, the truth 0."""
+    inp, empty, mask, shadow = _scene()
+    moved = empty.copy()
+    new_mask = np.roll(mask, 12, axis=1)
+    new_shadow = np.roll(shadow, 12, axis=1) & ~shadow
+    moved[new_shadow] *= 0.6
+    moved[new_mask] = (0.9, 0.1, 0.1)
+    region = M.relocation_region(inp, moved, empty, mask, new_mask)
+    assert region[mask].all() and region[new_mask].all()
+    assert region[shadow & ~M.dilate(mask | new_mask, 2)].mean() > 0.9
+    assert region[new_shadow & ~M.dilate(mask | new_mask, 2)].mean() > 0.9
+    assert not (region & ~M.dilate(shadow | new_shadow | mask | new_mask, 2)).any()
+    assert M.relocation_error_ratio(inp, inp, moved, region) == pytest.approx(1.0)
+    assert M.relocation_error_ratio(inp, moved, moved, region) == pytest.approx(0.0)
+    with pytest.raises(ValueError):
+        M.relocation_error_ratio(inp, inp, moved, np.zeros_like(region))

@@ -66,3 +66,20 @@ def test_an_edge_passing_close_to_a_pole_still_covers_the_rows_beside_it(offset)
     for width in (256, 1024):
         hits = trace_panorama(room, width, width // 2)
         assert (hits.tri >= 0).all(), f"{(hits.tri < 0).sum()} pixels missed at {width}"
+
+
+def test_first_hits_and_crossings_of_a_unit_cube():
+    from addon.raycast import crossings, first_hits
+
+    corners = np.array([[x, y, z] for x in (0.0, 1.0) for y in (0.0, 1.0) for z in (0.0, 1.0)])
+    faces = [(0, 1, 3), (0, 3, 2), (4, 6, 7), (4, 7, 5), (0, 4, 5), (0, 5, 1), (2, 3, 7), (2, 7, 6),
+             (0, 2, 6), (0, 6, 4), (1, 5, 7), (1, 7, 3)]
+    cube = corners[np.array(faces)]
+    origins = np.array([[0.5, 0.5, -1.0], [0.5, 0.5, 0.5], [2.0, 2.0, 0.5]])
+    up = np.broadcast_to([0.0, 0.0, 1.0], origins.shape)
+    index, t = first_hits(origins, up, cube)
+    np.testing.assert_allclose(t[:2], [1.0, 0.5])
+    assert t[2] == np.inf and index[2] == -1
+    assert set(cube[index[0]][:, 2]) == {0.0} and set(cube[index[1]][:, 2]) == {1.0}
+    count = crossings(np.array([[0.3, 0.6, -1.0], [0.3, 0.6, 0.5], [2.0, 2.0, 0.5]]), up, cube)
+    assert count.tolist() == [2, 1, 0]

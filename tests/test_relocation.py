@@ -1,0 +1,108 @@
+"""Relocation in the engine (DESIGN 6): removal and insertion undo each other, the object
+shows at its new place, and placements that break the constraint are refused."""
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+import tiny_scene
+from addon import latlong
+from addon.errors import DimredError
+from addon.fixedview import Move
+from addon.pipeline import relocate_object, remove_object
+from addon.radiosity import LUMA
+from addon.relocation import place
+
+
+@pytest.fixture(scope="module")
+def tiny(tmp_path_factory):
+    import bpy
+
+    from addon import bridge
+
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    hdri = tmp_path_factory.mktemp("tiny") / "room.exr"
+    tiny_scene.write_exr(hdri, tiny_scene.synthetic_hdri(128, 64))
+    tiny_scene.build_scene(hdri)
+    scene = bridge.read_scene(bpy.context.scene)
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    return scene
+
+
+def _box_pixels(scene, lo, hi) -> np.ndarray:
+    """(H, W) pixels whose ray from the probe enters the box lo..hi."""
+    h, w = scene.hdri.shape[:2]
+    d = latlong.pixel_directions(w, h)
+    return np.isfinite(tiny_scene._ray_box(np.asarray(scene.center), d, lo, hi))
+
+
+def test_moving_nowhere_gives_back_the_photograph(tiny):
+    """Insertion is removal run backwards: removed and put back in place, the panorama returns
+    to what it was, up to a small share of the removal's own change."""
+    removal = remove_object(tiny, "Box", quality="draft")
+    back = relocate_object(tiny, "Box", Move(0.0, 1.0), quality="draft")
+    assert np.isfinite(back.difference).all()
+    y_back, y_removal = np.abs(back.difference) @ LUMA, np.abs(removal.difference) @ LUMA
+    assert y_back.sum() <= 0.15 * y_removal.sum()
+    assert back.report["relocation"]["elevation_change"] == 0.0
+    assert back.report["relocation"]["residuals"][-1] < 0.2
+
+
+def test_the_object_shows_at_its_new_place(tiny):
+    result = relocate_object(tiny, "Box", Move(-90.0, 1.0), quality="draft")
+    rel = result.report["relocation"]
+    assert rel["support"] == ["Floor"] and rel["object_pixels"] > 0 and rel["insertion_passes"] == 2
+    assert np.isfinite(result.edited).all() and (result.edited >= 0).all()
+    lo, hi = np.array(tiny_scene.BOX[0]), np.array(tiny_scene.BOX[1])
+    old = _box_pixels(tiny, lo, hi)
+    # The box turned by -90 degrees about the probe's axis: (x, y) -> (y, -x).
+    new = _box_pixels(tiny, (lo[1], -hi[0], lo[2]), (hi[1], -lo[0], hi[2]))
+    core_old, core_new = old & ~latlong.dilate(~old, 1), new & ~latlong.dilate(~new, 1)
+    redness = result.edited[..., 0] / np.maximum(result.edited.sum(axis=2), 1e-9)
+    photo_redness = tiny.hdri[..., 0] / np.maximum(tiny.hdri.sum(axis=2), 1e-9)
+    assert photo_redness[core_old].mean() > 0.6
+    assert redness[core_new].mean() > 0.6 > redness[core_old].mean() + 0.15
+    assert result.hidden_mask[core_old].all() and result.hidden_mask[core_new].all()
+    assert result.report["seconds"]["total"] > 0 and "removal_synthesis" in result.report["seconds"]
+
+
+def _floating(scene, lift: float):
+    rows = np.asarray(scene.tri_object) == scene.object_names.index("Box")
+    tris = scene.triangles.copy()
+    tris[rows, :, 2] += lift
+    return replace(scene, triangles=tris)
+
+
+def _with_cabinet(scene):
+    """A second object standing where a 90-degree turn puts the box."""
+    lo, hi = (-0.3, 0.6, 0.0), (0.3, 1.4, 0.9)
+    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+    faces = [(0, 1, 3), (0, 3, 2), (4, 6, 7), (4, 7, 5), (0, 4, 5), (0, 5, 1), (2, 3, 7), (2, 7, 6),
+             (0, 2, 6), (0, 6, 4), (1, 5, 7), (1, 7, 3)]
+    tris = np.concatenate([scene.triangles, corners[np.array(faces)]])
+    ids = np.concatenate([scene.tri_object, np.full(len(faces), len(scene.object_names))])
+    return replace(scene, triangles=tris, tri_object=ids, object_names=[*scene.object_names, "Cabinet"])
+
+
+@pytest.mark.parametrize("case, move, expected", [
+    ("floating", Move(10.0, 1.0), "'Box' does not stand on a surface"),
+    ("through the wall", Move(0.0, 1.8), "would not stand on 'Floor'"),
+    ("into another object", Move(90.0, 1.0), "would cut through 'Cabinet'"),
+    ("no distance", Move(30.0, 0.0), "positive number"),
+])
+def test_placements_that_break_the_constraint_are_refused(tiny, case, move, expected):
+    scene = {"floating": _floating(tiny, 0.2), "into another object": _with_cabinet(tiny)}.get(case, tiny)
+    before = scene.triangles.copy()
+    with pytest.raises(DimredError, match=expected):
+        place(scene, scene.object_names.index("Box"), move)
+    with pytest.raises(DimredError, match=expected):
+        relocate_object(scene, "Box", move, quality="draft")
+    np.testing.assert_array_equal(scene.triangles, before)
+
+
+def test_a_move_along_the_floor_is_allowed(tiny):
+    placement = place(tiny, tiny.object_names.index("Box"), Move(135.0, 0.8))
+    assert placement.support == ["Floor"]
+    assert placement.elevation_change < 0.0  # nearer: seen more from above
