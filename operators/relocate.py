@@ -74,6 +74,16 @@ class Placement:
         return elevation_change(self.center, self.reference, move)
 
 
+def snapshot(obj: bpy.types.Object) -> dict[str, tuple[float, ...]]:
+    """The transform channels that setting matrix_world rewrites, for `restore`."""
+    return {name: tuple(getattr(obj, name)) for name in _TRANSFORM_CHANNELS}
+
+
+def restore(obj: bpy.types.Object, saved: dict[str, tuple[float, ...]]) -> None:
+    for name, value in saved.items():
+        setattr(obj, name, value)
+
+
 def _move(yaw: float, distance_scale: float) -> "Move":
     from ..addon.fixedview import Move
 
@@ -113,7 +123,7 @@ class DIMRED_OT_relocate(RunOperator, bpy.types.Operator):
             return {'CANCELLED'}
         settings = context.scene.dimred
         obj = settings.target
-        self._saved = {name: tuple(getattr(obj, name)) for name in _TRANSFORM_CHANNELS}
+        self._saved = snapshot(obj)
         self._tool = RelocateInput.starting_at(settings.yaw, settings.distance_scale, (event.mouse_x, event.mouse_y))
         self._show(context)
         context.window_manager.modal_handler_add(self)
@@ -163,8 +173,7 @@ class DIMRED_OT_relocate(RunOperator, bpy.types.Operator):
     def _end_tool(self, context: bpy.types.Context) -> None:
         obj = context.scene.objects.get(self._placement.object_name)
         if obj is not None:
-            for name, value in self._saved.items():
-                setattr(obj, name, value)
+            restore(obj, self._saved)
         if context.area is not None:
             context.area.header_text_set(None)
         self._tool = self._placement = self._saved = None

@@ -1,12 +1,15 @@
 """The Relocate operator end to end on the tiny room (background mode, so it runs synchronously):
 a refused move changes nothing; a relocation writes the layer, moves the object, undoes, redoes
 and clears; later removals see the object at its new place; relocating again starts from the
-photographed place and replaces the entry; the threaded run the interactive tool starts."""
+photographed place and replaces the entry; the threaded run the interactive tool starts, and
+what the tool does to the object (Blender's modal events need a window, which the bpy module
+has not: the input itself is tested in test_relocate_input.py)."""
 from __future__ import annotations
 
 import json
 import math
 from pathlib import Path
+from types import SimpleNamespace
 
 import bpy
 import numpy as np
@@ -184,3 +187,26 @@ def test_relocating_again_starts_from_the_photographed_place_and_replaces_the_en
     assert entry.photographed_matrix() == photographed
     np.testing.assert_allclose(np.array(box.matrix_world), _expected_matrix(photographed, -20.0, 0.8), atol=1e-5)
     np.testing.assert_array_equal(_layer(), _own(settings)["Box"])
+
+
+def test_the_interactive_tool_moves_the_box_and_cancel_restores_it_exactly(room, extension):
+    from diminished_reality.addon.fixedview import Move
+    from diminished_reality.operators import relocate
+    from diminished_reality.operators.relocate_input import RelocateInput
+
+    box = bpy.data.objects["Box"]
+    box.rotation_mode = 'XYZ'
+    box.rotation_euler = (0.0, 0.0, 0.1234567)
+    bpy.context.view_layer.update()
+    before = relocate.snapshot(box)
+    placement = relocate.Placement.of_target(bpy.context)
+    # The operator's own methods, on a stand-in for the running operator (no window here).
+    tool = SimpleNamespace(_tool=RelocateInput.starting_at(*MOVE), _placement=placement, _saved=before)
+    relocate.DIMRED_OT_relocate._show(tool, bpy.context)
+    np.testing.assert_allclose(np.array(box.matrix_world), _expected_matrix(placement.photographed, *MOVE), atol=1e-5)
+    assert relocate.snapshot(box) != before
+    assert placement.elevation_change(Move(*MOVE)) == pytest.approx(
+        math.degrees(math.atan2(-0.9, 1.3) - math.atan2(-0.9, 1.0)), abs=0.05)
+
+    relocate.DIMRED_OT_relocate._end_tool(tool, bpy.context)
+    assert relocate.snapshot(box) == before
