@@ -122,8 +122,7 @@ class DIMRED_OT_relocate(RunOperator, bpy.types.Operator):
             self.report({'ERROR'}, str(error))
             return {'CANCELLED'}
         settings = context.scene.dimred
-        obj = settings.target
-        self._saved = snapshot(obj)
+        self._saved = snapshot(settings.target)
         self._tool = RelocateInput.starting_at(settings.yaw, settings.distance_scale, (event.mouse_x, event.mouse_y))
         self._show(context)
         context.window_manager.modal_handler_add(self)
