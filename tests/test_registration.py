@@ -227,9 +227,13 @@ def test_panels_draw_existing_properties_operators_and_icons(registered, monkeyp
 
     scene = bpy.context.scene
     scene.dimred.surfaces.add().object = _mesh("Floor")
+    for name, kind in (("Chair", 'REMOVE'), ("Box", 'RELOCATE')):
+        entry = scene.dimred.removals.add()
+        entry.object_name, entry.kind, entry.yaw, entry.distance_scale = name, kind, -40.0, 1.3
     drawn = _draw(sidebar.DIMRED_PT_main, bpy.context)
     assert {f"operator dimred.{name}" for name in OPERATORS if name != "cancel"} <= set(drawn)
     assert "label Floor" in drawn and "operator dimred.cancel" not in drawn
+    assert {"prop yaw", "prop distance_scale", "label Chair", "label Box: yaw -40.0°, distance ×1.30"} <= set(drawn)
 
     # While a removal runs, its progress bar and Cancel replace the Remove button.
     running = type("Running", (), {"stage": "first_order", "fraction": 0.375})()
@@ -242,11 +246,13 @@ def test_panels_draw_existing_properties_operators_and_icons(registered, monkeyp
     assert not sidebar.DIMRED_PT_last_run.poll(bpy.context)
     scene.dimred.last_report = (
         '{"seconds": {"shadows": 1.5, "total": 2.0}, "skipped": [{"stage": "synthesis", "reason": "not yet"}],'
-        ' "warnings": ["hidden region not filled"], "guards": {"reflectance_clamped_patches": 3}}'
+        ' "warnings": ["hidden region not filled"], "guards": {"reflectance_clamped_patches": 3},'
+        ' "relocation": {"yaw": 40.0, "distance_scale": 1.3, "elevation_change": 7.3}}'
     )
     assert sidebar.DIMRED_PT_last_run.poll(bpy.context)
     assert "prop override_parameters" in _draw(sidebar.DIMRED_PT_parameters, bpy.context)
     drawn = _draw(sidebar.DIMRED_PT_last_run, bpy.context)
     for line in ("label total: 2.00 s", "label Skipped synthesis: not yet", "label hidden region not filled",
-                 "label reflectance_clamped_patches: 3"):
+                 "label reflectance_clamped_patches: 3",
+                 "label Moved: yaw 40.0°, distance ×1.30, view elevation +7.3°"):
         assert line in drawn
