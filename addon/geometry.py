@@ -24,6 +24,7 @@ class Geometry:
     object_names: list[str]
     scale: float  # size of the scene (bounding-box diagonal), for tolerances
     dropped_degenerate: int
+    source: np.ndarray  # (T,) row of each triangle in the scene's triangle list
 
     def object_triangles(self, index: int) -> np.ndarray:
         return np.flatnonzero(self.tri_object == index)
@@ -103,6 +104,7 @@ def build_geometry(
         object_names=list(object_names),
         scale=max(scale, 1e-9),
         dropped_degenerate=int((~keep).sum()),
+        source=np.flatnonzero(keep),
     )
 
 

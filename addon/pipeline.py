@@ -1,6 +1,7 @@
-"""The engine's front door: validate a SceneData, pick the preset, run the removal.
+"""The engine's front door: validate a SceneData, pick the preset, run the removal or relocation.
 
-The command line, the Blender operators and the tests all call `remove_object`.
+The command line, the Blender operators and the tests all call `remove_object` or
+`relocate_object`.
 """
 from __future__ import annotations
 
@@ -10,7 +11,9 @@ from typing import Callable, Sequence
 import numpy as np
 
 from .errors import DimredError
-from .quality import params_for
+from .fixedview import Move, check_move
+from .quality import Params, params_for
+from .relocation import relocate
 from .removal import RemovalResult, remove
 from .scene import SceneData
 
@@ -32,6 +35,27 @@ def validate(scene: SceneData) -> None:
         raise DimredError("the probe centre is not a finite point")
 
 
+def _run(scene: SceneData, quality: str, overrides: dict, compute: Callable[[SceneData, Params], RemovalResult]
+         ) -> RemovalResult:
+    validate(scene)
+    params = params_for(quality, **overrides)
+    # Negative radiance is not light (a bad merge or a denoiser's ringing): the engine reads it
+    # as black, and those pixels are passed through as they are.
+    negative = int((scene.hdri < 0).any(axis=2).sum())
+    original = scene.hdri
+    if negative:
+        scene = replace(scene, hdri=np.maximum(scene.hdri, 0.0))
+    result = compute(scene, params)
+    result.report["guards"]["negative_input_pixels_clamped"] = negative
+    if negative:
+        result.edited = (original + result.difference).astype(np.float32)
+    result.report["quality"] = quality
+    result.report["parameters"] = {k: getattr(params, k) for k in params.__dataclass_fields__}
+    result.report["image_size"] = [int(scene.hdri.shape[1]), int(scene.hdri.shape[0])]
+    result.report.setdefault("notes", []).extend(scene.notes)
+    return result
+
+
 def remove_object(
     scene: SceneData,
     object_name: str,
@@ -45,20 +69,23 @@ def remove_object(
     """Remove `object_name` from the scene's panorama; `overrides` change single parameters.
 
     `preview(difference)` gets coarse difference images before the result (see `removal.remove`)."""
-    validate(scene)
-    params = params_for(quality, **overrides)
-    # Negative radiance is not light (a bad merge or a denoiser's ringing): the engine reads it
-    # as black, and those pixels are passed through as they are.
-    negative = int((scene.hdri < 0).any(axis=2).sum())
-    original = scene.hdri
-    if negative:
-        scene = replace(scene, hdri=np.maximum(scene.hdri, 0.0))
-    result = remove(scene, object_name, list(planes), params, progress, cancel, preview)
-    result.report["guards"]["negative_input_pixels_clamped"] = negative
-    if negative:
-        result.edited = (original + result.difference).astype(np.float32)
-    result.report["quality"] = quality
-    result.report["parameters"] = {k: getattr(params, k) for k in params.__dataclass_fields__}
-    result.report["image_size"] = [int(scene.hdri.shape[1]), int(scene.hdri.shape[0])]
-    result.report.setdefault("notes", []).extend(scene.notes)
-    return result
+    return _run(scene, quality, overrides,
+                lambda s, params: remove(s, object_name, list(planes), params, progress, cancel, preview))
+
+
+def relocate_object(
+    scene: SceneData,
+    object_name: str,
+    move: Move,
+    planes: Sequence[str] = (),
+    quality: str = "balanced",
+    progress: Callable[[str, float], None] | None = None,
+    cancel: Callable[[], bool] | None = None,
+    preview: Callable[[np.ndarray], None] | None = None,
+    **overrides,
+) -> RemovalResult:
+    """Move `object_name` under the fixed-view constraint (see `relocation.relocate`): the
+    same images and report as a removal, with `report["relocation"]` describing the move."""
+    check_move(move)
+    return _run(scene, quality, overrides,
+                lambda s, params: relocate(s, object_name, move, list(planes), params, progress, cancel, preview))

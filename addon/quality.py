@@ -33,6 +33,7 @@ class Params:
     synth_levels: int = 0  # pyramid levels of the synthesis, 0 = from the hole's size
     synth_generations: int = 2  # synthesis passes per level: more settle seams, slower
     seed: int = 0  # the synthesis's random seed: the same seed gives the same fill
+    insertion_passes: int = 2  # relocation: solver passes towards the inserted object's fixed point (2 at least: the first lacks its reflected light)
 
 
 PRESETS = {
@@ -42,7 +43,7 @@ PRESETS = {
     "balanced": Params(),
     "final": Params(patches=1200, object_patches=300, sender_fraction=0.995, max_senders=64, sender_samples=6,
                     fine_cells=5.0, fine_pixels=3.0, reach=0.05, significance=0.003, patch_samples=3, max_bounces=16,
-                    bounce_tolerance=5e-4),
+                    bounce_tolerance=5e-4, insertion_passes=3),
 }
 
 

@@ -295,3 +295,32 @@ def _morton(q: np.ndarray) -> np.ndarray:
             code |= ((q[:, axis] >> bit) & 1) << (3 * bit + axis)
     return code
 
+
+
+def first_hits(origins: np.ndarray, directions: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(N,) the first of `triangles` (T, 3, 3) each ray origin + t direction (t > 0) hits, -1
+    for none, and its t (inf for none). Brute force over all triangles: for a few rays."""
+    o = np.asarray(origins, dtype=np.float64)
+    d = np.asarray(directions, dtype=np.float64)
+    best = np.full(len(o), np.inf)
+    index = np.full(len(o), -1, dtype=np.int64)
+    v0, e1, e2 = triangles[:, 0], triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0]
+    per = max(1, _PAIR_CHUNK // max(len(o), 1))
+    for j0 in range(0, len(triangles), per):
+        sl = slice(j0, j0 + per)
+        p = np.cross(d[:, None, :], e2[None, sl])
+        det = np.einsum("tc,ntc->nt", e1[sl], p)
+        ok = np.abs(det) > 1e-20
+        inv = 1.0 / np.where(ok, det, 1.0)
+        t_vec = o[:, None, :] - v0[None, sl]
+        u = np.einsum("ntc,ntc->nt", t_vec, p) * inv
+        q = np.cross(t_vec, e1[None, sl])
+        v = np.einsum("nc,ntc->nt", d, q) * inv
+        t = np.einsum("tc,ntc->nt", e2[sl], q) * inv
+        hit = ok & (u >= 0.0) & (v >= 0.0) & (u + v <= 1.0) & (t > 0.0)
+        t = np.where(hit, t, np.inf)
+        k = t.argmin(axis=1)
+        tk = t[np.arange(len(o)), k]
+        closer = tk < best
+        best[closer], index[closer] = tk[closer], j0 + k[closer]
+    return index, best

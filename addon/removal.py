@@ -624,21 +624,31 @@ class _Removal:
         return d
 
 
-def remove(
-    scene: SceneData,
-    object_name: str,
-    planes: list[str] | tuple[str, ...] = (),
-    params: Params | None = None,
-    progress: Callable[[str, float], None] | None = None,
-    cancel: Callable[[], bool] | None = None,
-    preview: Callable[[np.ndarray], None] | None = None,
-) -> RemovalResult:
-    """Remove `object_name`'s shadows and reflected light from the scene's panorama.
+@dataclass
+class Solution:
+    """A removal's solved lighting before the panorama is edited: the job (geometry, hits),
+    the room's radiosity, the change db of its patches with every bounce, the split patches,
+    and per hit pixel (`job.hp`) E with the object and the change dE once it is gone."""
 
-    `preview(difference)` gets (H, W, 3) float32 difference images before the result: the
-    lighting corrected with the hidden region roughly filled, then refined level by level."""
-    params = params or Params()
-    rep = Report(progress, stages=8)
+    job: _Removal
+    room: _Room
+    db: np.ndarray
+    split: Split
+    e_pix: np.ndarray
+    de_pix: np.ndarray
+
+    def irradiance(self, tri: np.ndarray, bary: np.ndarray) -> np.ndarray:
+        """(N, 3) E with the object in place at the points (geometry triangle, barycentric
+        weights of vertices 1 and 2), on a fine lattice over those triangles: points on the
+        object itself too, which the pixel stages leave out."""
+        _, _, e, _, inverse, weights = self.job._fine_transport(self.room, tri, bary, self.db, self.split)
+        return np.maximum(_interp(e, inverse, weights), 0.0)
+
+
+def solve(scene: SceneData, object_name: str, planes: list[str] | tuple[str, ...], params: Params, rep: Report,
+          cancel: Callable[[], bool] | None = None) -> Solution:
+    """Every stage of the removal up to the new irradiance of each pixel (DESIGN 3, steps 1-5
+    and 8); the stages are timed in `rep`."""
     check = _cancel_check(cancel)
     if object_name not in scene.object_names:
         raise DimredError(f"no mesh object named '{object_name}' among the scene's proxy geometry")
@@ -673,8 +683,15 @@ def remove(
     check()
     with rep.stage("local"):
         e_pix, de_pix = job.local(room, db, split)
+    return Solution(job, room, db, split, e_pix, de_pix)
+
+
+def finish(solution: Solution, rep: Report, preview: Callable[[np.ndarray], None] | None = None) -> RemovalResult:
+    """The edited panorama from a solved removal: the ratio form on the pixels that keep their
+    surface, texture synthesis where the object was (see `remove`)."""
+    job, room, db, split = solution.job, solution.room, solution.db, solution.split
     with rep.stage("compose"):
-        d = job.compose(e_pix, de_pix)
+        d = job.compose(solution.e_pix, solution.de_pix)
 
     def difference_image(d_revealed: np.ndarray) -> np.ndarray:
         d[job.revealed] = d_revealed
@@ -685,12 +702,29 @@ def remove(
     if len(job.revealed):
         show = None if preview is None else lambda d_revealed: preview(difference_image(d_revealed))
         with rep.stage("synthesis"):
-            d_revealed = job.fill_hidden(room, e_pix, db, split, show)
+            d_revealed = job.fill_hidden(room, solution.e_pix, db, split, show)
     else:
         d_revealed = np.zeros((0, 3))
         rep.skip("synthesis", "the object is not visible from the probe centre: no hidden region to fill"
                  if not job.hidden_h.any() else "nothing is behind the object to fill")
     difference = difference_image(d_revealed)
-    edited = (scene.hdri + difference).astype(np.float32)
+    edited = (job.hdri + difference).astype(np.float32)
     rep.info["hidden_region_filled"] = bool(len(job.revealed) == job.hidden_h.sum())
     return RemovalResult(difference=difference, edited=edited, hidden_mask=job.hidden_map, report=rep.as_dict())
+
+
+def remove(
+    scene: SceneData,
+    object_name: str,
+    planes: list[str] | tuple[str, ...] = (),
+    params: Params | None = None,
+    progress: Callable[[str, float], None] | None = None,
+    cancel: Callable[[], bool] | None = None,
+    preview: Callable[[np.ndarray], None] | None = None,
+) -> RemovalResult:
+    """Remove `object_name`'s shadows and reflected light from the scene's panorama.
+
+    `preview(difference)` gets (H, W, 3) float32 difference images before the result: the
+    lighting corrected with the hidden region roughly filled, then refined level by level."""
+    rep = Report(progress, stages=8)
+    return finish(solve(scene, object_name, planes, params or Params(), rep, cancel), rep, preview)

@@ -15,6 +15,7 @@ import dataclasses
 import hashlib
 import importlib.metadata
 import json
+import math
 from dataclasses import dataclass, field
 from functools import cache
 from pathlib import Path
@@ -450,6 +451,21 @@ SPECS: dict[str, SceneSpec] = {s.name: s for s in (
     _grazing(),
     _demo(),
 )}
+
+
+def relocated(spec: SceneSpec, yaw: float, distance_scale: float) -> SceneSpec:
+    """`spec` with its removed object moved under the fixed-view constraint: turned by `yaw`
+    degrees about the vertical axis through the probe and its horizontal distance from that axis
+    times `distance_scale` (the render of this spec is the truth of that relocation). The
+    object's footprint centre is the centre of its bounding box, as the engine takes it."""
+    obj = spec.removed_object()
+    a = math.radians(yaw)
+    dx, dy = obj.location[0] - spec.probe[0], obj.location[1] - spec.probe[1]
+    x = spec.probe[0] + distance_scale * (math.cos(a) * dx - math.sin(a) * dy)
+    y = spec.probe[1] + distance_scale * (math.sin(a) * dx + math.cos(a) * dy)
+    moved = dataclasses.replace(obj, location=(x, y, obj.location[2]), rotation_z=obj.rotation_z + yaw)
+    return dataclasses.replace(spec, name=f"{spec.name}_moved", objects=tuple(
+        moved if o.name == obj.name else o for o in spec.objects))
 
 
 def get(name: str) -> SceneSpec:

@@ -1,0 +1,290 @@
+"""Relocating a real object under the fixed-view constraint (DESIGN 6, thesis chapter 5).
+
+A relocation is the removal at the old place followed by an insertion at the new one.
+Insertion is removal run backwards: removal turns the panorama L1 (object present) into
+L0 = L1 E'/E, with E the irradiance with the object and E' without it. Insertion has L0 and
+wants L1 = L0 E/E'. Both E come from the radiosity of the room as the panorama shows it, here
+the unknown L1, so L1 is a fixed point; the removal's own solver reaches it in a few passes
+(the first already holds the lamps' shadow exactly, the next ones the light the object
+reflects and the bounces it takes away).
+
+The object's appearance is carried along the move. Each of its points at the new place takes
+the photograph's radiance at its old place (where the probe saw it there), divided by the
+irradiance there, which removes the shadows other things cast on it as far as the model holds
+(thesis 5.2), and lit with the irradiance at the new place. The object hides what is behind it
+at the new place because every pixel is traced again with the moved geometry.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from typing import Callable
+
+import numpy as np
+
+from . import fixedview, latlong
+from .errors import DimredError
+from .fixedview import Move
+from .quality import Params
+from .radiosity import LUMA, RHO_MAX
+from .raycast import Occluders, first_hits
+from .removal import RemovalResult, Solution, finish, solve
+from .report import Report
+from .scene import SceneData
+
+_RATIO_MAX = 4.0  # an insertion darkens (shadow) or brightens a little (reflected light); beyond this the model failed
+_SUPPORT_GAP = 0.02  # of the object's height: a foot this close above a surface stands on it
+_SEEN_DEPTH = 0.02  # a photographed pixel shows a point of the object if its depth agrees to this share
+
+
+@dataclass
+class Placement:
+    """Where the move puts the object (world space), and what it stands on."""
+
+    matrix: np.ndarray  # (4, 4) the move
+    triangles: np.ndarray  # (T, 3, 3) the scene's triangles with the object moved
+    support: list[str]  # the objects it stands on
+    elevation_change: float  # degrees, see fixedview.elevation_change
+
+
+def place(scene: SceneData, target: int, move: Move) -> Placement:
+    """The object moved by `move`, or a DimredError when the new place breaks the constraint:
+    the object would not stand on the surface it stands on now, would cut through another
+    object or a wall, or would enclose the probe."""
+    fixedview.check_move(move)
+    rows = scene.tri_object == target
+    tris = np.asarray(scene.triangles, dtype=np.float64)
+    obj = tris[rows]
+    name = scene.object_names[target]
+    reference = fixedview.reference_point(obj)
+    matrix = fixedview.move_matrix(scene.center, reference, move)
+    moved = tris.copy()
+    moved[rows] = fixedview.apply(matrix, obj)
+    others = tris[~rows]
+    other_ids = np.asarray(scene.tri_object)[~rows]
+    pts = obj.reshape(-1, 3)
+    size = float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0)))
+    height = float(np.ptp(pts[:, 2]))
+    scene_size = float(np.ptp(tris.reshape(-1, 3), axis=0).max())
+    lift = 1e-3 * max(size, 1e-9)
+    tolerance = lift + _SUPPORT_GAP * max(height, size * 1e-2)
+
+    feet = np.unique(pts[pts[:, 2] <= pts[:, 2].min() + 1e-2 * max(height, 1e-9)], axis=0)
+    down = np.broadcast_to([0.0, 0.0, -1.0], feet.shape)
+    hit, t = first_hits(feet + [0.0, 0.0, lift], down, others)
+    stands = t <= tolerance
+    if not stands.any():
+        raise DimredError(
+            f"'{name}' does not stand on a surface (nothing within {tolerance:.3g} below its lowest points): a "
+            "relocation keeps an object on its support plane, so model the surface it stands on"
+        )
+    support_ids = np.unique(other_ids[hit[stands]])
+    new_feet = fixedview.apply(matrix, feet[stands])
+    hit_new, t_new = first_hits(new_feet + [0.0, 0.0, lift], down[: len(new_feet)], others)
+    off = ~((t_new <= tolerance) & np.isin(other_ids[np.maximum(hit_new, 0)], support_ids))
+    support = [scene.object_names[k] for k in support_ids]
+    if off.any():
+        below = sorted({scene.object_names[other_ids[k]] for k in hit_new[off] if k >= 0})
+        where = f"over {', '.join(repr(n) for n in below)}" if below else "over nothing"
+        raise DimredError(
+            f"at the new place '{name}' would not stand on {', '.join(repr(n) for n in support)}: "
+            f"{int(off.sum())} of its feet would be {where}. Choose a smaller move"
+        )
+
+    new_pts = moved[rows].reshape(-1, 3)
+    centre = np.asarray(scene.center, dtype=np.float64)
+    if np.all(new_pts.min(axis=0) < centre) and np.all(new_pts.max(axis=0) > centre):
+        raise DimredError(f"at the new place '{name}' would enclose the probe centre")
+    collided = _collisions(obj, moved[rows], others, other_ids, support_ids, 1e-6 * max(scene_size, 1e-9))
+    if collided:
+        raise DimredError(
+            f"at the new place '{name}' would cut through {', '.join(repr(scene.object_names[k]) for k in collided)}"
+        )
+    return Placement(matrix, moved, support, fixedview.elevation_change(scene.center, reference, move))
+
+
+def _collisions(before: np.ndarray, after: np.ndarray, others: np.ndarray, other_ids: np.ndarray,
+                support: np.ndarray, eps: float) -> list[int]:
+    """Objects (not the support) that the moved object's edges cross and its old edges did not
+    (a model that already touched a wall a little is not refused for that)."""
+    found = []
+    for k in np.unique(other_ids):
+        if k in support:
+            continue
+        occ = Occluders(others[other_ids == k], other_ids[other_ids == k], eps)
+
+        def crosses(tris: np.ndarray) -> bool:
+            a = tris.reshape(-1, 3)
+            b = np.roll(tris, -1, axis=1).reshape(-1, 3)
+            return bool(occ.blocked(a, b).any())
+
+        if crosses(after) and not crosses(before):
+            found.append(int(k))
+    return found
+
+
+def _map_rows(old: Solution, new: Solution, tri_new: np.ndarray) -> np.ndarray:
+    """Triangle indices of the old geometry for triangles of the new one (the same rows of the
+    scene's triangle list; -1 where the old geometry dropped the row)."""
+    n = int(max(old.job.geo.source.max(), new.job.geo.source.max())) + 1
+    index = np.full(n, -1, dtype=np.int64)
+    index[old.job.geo.source] = np.arange(len(old.job.geo.source))
+    return index[new.job.geo.source[tri_new]]
+
+
+def _photographed(old: Solution, photo: np.ndarray, tri: np.ndarray, bary: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(N, 3) the photograph's radiance at points of the object given in the old geometry, and
+    (N,) whether the probe saw them there (bilinear over the neighbouring pixels that show the
+    object at the point's depth)."""
+    job = old.job
+    tris = job.geo.triangles[tri]
+    points = tris[:, 0] + bary[:, :1] * (tris[:, 1] - tris[:, 0]) + bary[:, 1:] * (tris[:, 2] - tris[:, 0])
+    depth = np.linalg.norm(points, axis=1)
+    u, v = latlong.direction_to_uv(points / np.maximum(depth, 1e-300)[:, None])
+    x = u * job.width - 0.5
+    y = (1.0 - v) * job.height - 0.5
+    x0, y0 = np.floor(x).astype(np.int64), np.floor(y).astype(np.int64)
+    on_object = job.geo.tri_object[np.maximum(job.hits.tri, 0)] == job.target
+    on_object &= job.hits.tri >= 0
+    total = np.zeros((len(points), 3))
+    weight = np.zeros(len(points))
+    for dy in (0, 1):
+        for dx in (0, 1):
+            yy = np.clip(y0 + dy, 0, job.height - 1)
+            xx = (x0 + dx) % job.width
+            w = (1.0 - np.abs(x - (x0 + dx))) * (1.0 - np.abs(y - (y0 + dy)))
+            ok = on_object[yy, xx] & (np.abs(job.hits.distance[yy, xx] - depth) <= _SEEN_DEPTH * depth)
+            w = np.where(ok, w, 0.0)
+            total += w[:, None] * photo[yy, xx]
+            weight += w
+    seen = weight > 0.25
+    return np.where(seen[:, None], total / np.maximum(weight, 1e-300)[:, None], 0.0), seen
+
+
+def _appearance(old: Solution, new: Solution, photo: np.ndarray, rep: Report) -> tuple[np.ndarray, np.ndarray]:
+    """Flat pixel indices of the object at the new place and their radiance (N, 3): the
+    reflectance it showed at the old place lit by the irradiance at the new one."""
+    job = new.job
+    on = job.obj_h == job.target
+    pix = job.hp[on]
+    tri_new = job.tri_h[on]
+    bary = job.hits.bary.reshape(-1, 2)[pix]
+    tri_old = _map_rows(old, new, tri_new)
+    known = tri_old >= 0
+    radiance = np.zeros((len(pix), 3))
+    seen = np.zeros(len(pix), dtype=bool)
+    e_old = np.zeros((len(pix), 3))
+    if known.any():
+        radiance[known], seen[known] = _photographed(old, photo, tri_old[known], bary[known])
+        e_old[known] = old.irradiance(tri_old[known], bary[known])
+    e_new = new.irradiance(tri_new, bary)
+    y_old = e_old @ LUMA
+    lit = seen & (y_old > 1e-3 * max(float(np.median(y_old[seen])) if seen.any() else 0.0, 1e-30))
+    implied = np.pi * radiance[lit] / np.maximum(e_old[lit], 1e-30)
+    rep.guard("object_reflectance_clamped_pixels", int((implied > RHO_MAX).any(axis=1).sum()))
+    rho = np.zeros((len(pix), 3))
+    rho[lit] = np.clip(implied, 0.0, RHO_MAX)
+    if lit.any():
+        fallback = np.median(rho[lit], axis=0)
+    else:
+        on_object = old.room.senders.on_removed
+        fallback = np.median(old.room.rho[on_object], axis=0)
+        rep.warn("the probe did not see the object well enough to take its appearance from the panorama: "
+                 "it is shown with its estimated mean reflectance")
+    rho[~lit] = fallback
+    unseen = int((~lit).sum())
+    if unseen:
+        # Points the photograph does not show: a nearer object is seen more from above, or its
+        # own self-shadow was too dark to measure.
+        rep.guard("object_pixels_without_photograph", unseen)
+    return pix, rho * e_new / np.pi
+
+
+def _scaled(progress: Callable[[str, float], None] | None, lo: float, hi: float, prefix: str):
+    if progress is None:
+        return None
+    return lambda stage, fraction: progress(f"{prefix}{stage}", lo + (hi - lo) * fraction)
+
+
+def relocate(
+    scene: SceneData,
+    object_name: str,
+    move: Move,
+    planes: list[str] | tuple[str, ...] = (),
+    params: Params | None = None,
+    progress: Callable[[str, float], None] | None = None,
+    cancel: Callable[[], bool] | None = None,
+    preview: Callable[[np.ndarray], None] | None = None,
+) -> RemovalResult:
+    """Move `object_name` by `move` in the panorama: removed at its old place, inserted at the
+    new one with its shadow and reflected light. `preview` gets difference images as for a
+    removal, then one after each insertion pass."""
+    params = params or Params()
+    if object_name not in scene.object_names:
+        raise DimredError(f"no mesh object named '{object_name}' among the scene's proxy geometry")
+    target = scene.object_names.index(object_name)
+    if not (np.asarray(scene.tri_object) == target).any():
+        raise DimredError(f"'{object_name}' has no faces to move")
+    placement = place(scene, target, move)
+    passes = params.insertion_passes
+    share = 1.0 / (1 + passes)
+
+    rep = Report(_scaled(progress, 0.0, share, "removal: "), stages=8)
+    old = solve(scene, object_name, planes, params, rep, cancel)
+    removed = finish(old, rep, preview)
+    report = removed.report
+
+    photo = np.asarray(scene.hdri, dtype=np.float64)
+    without = np.asarray(removed.edited, dtype=np.float64).reshape(-1, 3)
+    current = without.copy()
+    moved_scene = replace(scene, triangles=placement.triangles)
+    insertion = Report()
+    residuals = []
+    for k in range(passes):
+        step = Report(_scaled(progress, share * (k + 1), share * (k + 2), f"insertion {k + 1}/{passes}: "), stages=7)
+        image = current.reshape(photo.shape).astype(np.float32)
+        new = solve(replace(moved_scene, hdri=image), object_name, planes, params, step, cancel)
+        with insertion.stage("insertion"):
+            updated = without.copy()
+            job = new.job
+            room = (job.obj_h != job.target) & ~job.emitter_h
+            e = new.e_pix[room]
+            e_without = e + new.de_pix[room]
+            y_ref = float(np.median(e @ LUMA)) if room.any() else 0.0
+            ok = (e_without @ LUMA > 1e-6 * max(y_ref, 1e-30))[:, None] & (e_without > 0.0)
+            ratio = np.where(ok, e / np.where(ok, e_without, 1.0), 1.0)
+            wild = (ratio > _RATIO_MAX).any(axis=1)
+            ratio = np.clip(ratio, 0.0, _RATIO_MAX)
+            updated[job.hp[room]] = without[job.hp[room]] * ratio
+            pix, radiance = _appearance(old, new, photo, insertion)
+            updated[pix] = radiance
+            y_new, y_without = updated @ LUMA, without @ LUMA
+            # The share of the insertion's change that this pass still changed: how far from its fixed point.
+            residuals.append(float(np.abs(y_new - current @ LUMA).sum() / max(float(np.abs(y_new - y_without).sum()), 1e-30)))
+            current = updated
+        if preview is not None:
+            preview((current.reshape(photo.shape) - photo).astype(np.float32))
+    last = step.as_dict()
+    insertion.guard("insertion_ratio_clamped_pixels", int(wild.sum()))
+    difference = (current.reshape(photo.shape) - photo).astype(np.float32)
+    hidden = removed.hidden_mask.ravel().copy()
+    hidden[pix] = True
+    done = insertion.as_dict()
+    report["seconds"] = {**{f"removal_{k}": v for k, v in report["seconds"].items() if k != "total"},
+                         **{f"insertion_{k}": v for k, v in last["seconds"].items() if k != "total"},
+                         "insertion": done["seconds"].get("insertion", 0.0),
+                         "total": round(report["seconds"]["total"] + done["seconds"]["total"], 4)}
+    report["warnings"] = list(dict.fromkeys(report["warnings"] + last["warnings"] + done["warnings"]))
+    report["guards"].update({f"insertion_{k}": v for k, v in last["guards"].items()})
+    report["guards"].update(done["guards"])
+    report["relocation"] = dict(
+        yaw=move.yaw, distance_scale=move.distance_scale, elevation_change=round(placement.elevation_change, 3),
+        matrix=placement.matrix.tolist(), support=placement.support, object_pixels=int(len(pix)),
+        insertion_passes=passes, residuals=[round(r, 5) for r in residuals],
+    )
+    if abs(placement.elevation_change) > 10.0:
+        report["warnings"].append(
+            f"the move changes the elevation the object is seen at by {placement.elevation_change:+.1f} degrees: "
+            "its sides and top now show at angles the photograph did not see, which the carried appearance cannot show"
+        )
+    return RemovalResult(difference=difference, edited=(photo + difference).astype(np.float32),
+                         hidden_mask=hidden.reshape(photo.shape[:2]), report=report)
