@@ -1,7 +1,9 @@
-"""One removal as the Blender operator runs it: plain data in, staged files out (no bpy).
+"""One removal (or relocation) as the Blender operator runs it: plain data in, staged files out
+(no bpy).
 
 The operator gathers a `RemovalRequest` on the main thread and runs `run` either in a worker
-thread or, in background mode, directly. Removals compose: the request carries the difference
+thread or, in background mode, directly. A request with a `move` relocates the object (removal
+at the photographed place, insertion at the moved one) and is otherwise handled the same. Removals compose: the request carries the difference
 of the objects removed before (`base`), the engine works on HDRI + base, and the world layer
 shows base + this run's difference. Files are written under temporary names next to their
 final paths and only `Staged.commit` (on the main thread, once the run is accepted) renames them
@@ -10,6 +12,7 @@ into place, so a cancelled or failed run leaves earlier results as they were.
 from __future__ import annotations
 
 import contextlib
+import functools
 import os
 import secrets
 from dataclasses import dataclass, field, replace
@@ -19,7 +22,8 @@ import numpy as np
 
 from .errors import Cancelled, DimredError
 from .exr import read_exr, write_exr
-from .pipeline import remove_object
+from .fixedview import Move
+from .pipeline import relocate_object, remove_object
 from .scene import SceneData
 
 
@@ -33,6 +37,7 @@ class RemovalRequest:
     own_path: str = ""  # where this removal's own difference goes
     layer_path: str = ""  # where base + own difference (what the world shows) goes
     overrides: dict = field(default_factory=dict)  # engine parameters that replace the preset's
+    move: Move | None = None  # relocate the object by this move instead of removing it
 
 
 @dataclass
@@ -82,7 +87,7 @@ def run(
     cancel: Callable[[], bool] | None = None,
     preview: Callable[[np.ndarray], None] | None = None,
 ) -> RemovalOutcome:
-    """Remove the requested object; `preview` gets the layer (base + difference so far) as
+    """Remove (or relocate) the requested object; `preview` gets the layer (base + difference so far) as
     `blender_pixels` buffers, ready for the main thread to show."""
     scene = loaded(request.scene)
     base = request.base
@@ -95,8 +100,9 @@ def run(
         scene = replace(scene, hdri=(scene.hdri + base).astype(np.float32))
     show = None if preview is None else (
         lambda difference: preview(blender_pixels(difference if base is None else difference + base)))
-    result = remove_object(scene, request.object_name, request.planes, request.quality, progress, cancel,
-                           preview=show, **request.overrides)
+    engine = remove_object if request.move is None else functools.partial(relocate_object, move=request.move)
+    result = engine(scene, request.object_name, planes=request.planes, quality=request.quality, progress=progress,
+                    cancel=cancel, preview=show, **request.overrides)
     layer = result.difference if base is None else (result.difference + base).astype(np.float32)
     if cancel is not None and cancel():
         raise Cancelled()

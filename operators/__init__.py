@@ -1,10 +1,10 @@
 """The `scene.dimred` settings and the `bpy.ops.dimred.*` operators, registered in order."""
 from __future__ import annotations
 
-from . import marking, removal, session, settings
+from . import marking, relocate, removal, session, settings
 
 # Settings first: the operators and the panel read scene.dimred.
-_modules = (settings, session, marking, removal)
+_modules = (settings, session, marking, removal, relocate)
 
 
 def register() -> None:

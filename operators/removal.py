@@ -1,4 +1,5 @@
-"""Operators that run the removal and manage its result: remove, cancel, clear, save HDRI.
+"""Operators that run the removal and manage its result: remove, cancel, clear, save HDRI; and
+the run that Remove and Relocate share.
 
 Remove invoked from the UI computes in a worker thread (`session.RemovalSession`) while a modal
 operator polls it on a timer, shows progress in the panel and the status bar, and previews the
@@ -8,12 +9,17 @@ end synchronously. The engine is imported only when a run starts, so registering
 """
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import bpy
 from bpy.props import BoolProperty, StringProperty
 
 from ..addon.errors import DimredError
 from . import session as S
 from . import world_layer
+
+if TYPE_CHECKING:  # the engine is imported only when a run starts
+    from ..addon.fixedview import Move
 
 # Seconds between the modal operator's polls of the worker: fast enough that Esc acts at once
 # and progress moves smoothly, slow enough to cost nothing.
@@ -27,15 +33,11 @@ def _world_poll(cls: type[bpy.types.Operator], context: bpy.types.Context) -> bo
     return True
 
 
-class DIMRED_OT_remove(bpy.types.Operator):
-    bl_idname = "dimred.remove"
-    bl_label = "Remove Object"
-    bl_description = (
-        "Compute the difference image that removes the marked object, its shadow and its reflected "
-        "light from the panorama, and show HDRI + difference in the world. Runs in the background "
-        "with progress; Esc cancels"
-    )
-    bl_options = {'REGISTER', 'UNDO'}
+class RunOperator:
+    """What Remove and Relocate share: a run of `session.RemovalSession`, synchronous from
+    `execute` and threaded from `invoke` (a modal operator polling it on a timer, Esc cancels).
+
+    Subclasses say what to run with `move` (None: remove)."""
 
     _timer = None
     _session: S.RemovalSession | None = None
@@ -52,9 +54,12 @@ class DIMRED_OT_remove(bpy.types.Operator):
             return False
         return True
 
+    def move(self) -> "Move | None":
+        return None
+
     def execute(self, context: bpy.types.Context) -> set[str]:
         try:
-            run = S.RemovalSession.begin(context)
+            run = S.RemovalSession.begin(context, self.move())
         except DimredError as error:
             self.report({'ERROR'}, str(error))
             return {'CANCELLED'}
@@ -63,17 +68,23 @@ class DIMRED_OT_remove(bpy.types.Operator):
     def invoke(self, context: bpy.types.Context, event: bpy.types.Event) -> set[str]:
         if bpy.app.background or context.window is None:
             return self.execute(context)
+        if not self._launch(context):
+            return {'CANCELLED'}
+        context.window_manager.modal_handler_add(self)
+        return {'RUNNING_MODAL'}
+
+    def _launch(self, context: bpy.types.Context) -> bool:
+        """Begin the session in a worker thread and poll it on a timer; False (reported) when
+        the input is refused."""
         try:
-            self._session = S.RemovalSession.begin(context)
+            self._session = S.RemovalSession.begin(context, self.move())
         except DimredError as error:
             self.report({'ERROR'}, str(error))
-            return {'CANCELLED'}
+            return False
         self._session.start()
-        wm = context.window_manager
-        self._timer = wm.event_timer_add(POLL_INTERVAL, window=context.window)
-        wm.modal_handler_add(self)
+        self._timer = context.window_manager.event_timer_add(POLL_INTERVAL, window=context.window)
         self._status(context)
-        return {'RUNNING_MODAL'}
+        return True
 
     def modal(self, context: bpy.types.Context, event: bpy.types.Event) -> set[str]:
         run = self._session
@@ -109,6 +120,17 @@ class DIMRED_OT_remove(bpy.types.Operator):
         return {'FINISHED'} if ok else {'CANCELLED'}
 
 
+class DIMRED_OT_remove(RunOperator, bpy.types.Operator):
+    bl_idname = "dimred.remove"
+    bl_label = "Remove Object"
+    bl_description = (
+        "Compute the difference image that removes the marked object, its shadow and its reflected "
+        "light from the panorama, and show HDRI + difference in the world. Runs in the background "
+        "with progress; Esc cancels"
+    )
+    bl_options = {'REGISTER', 'UNDO'}
+
+
 class DIMRED_OT_cancel(bpy.types.Operator):
     bl_idname = "dimred.cancel"
     bl_label = "Cancel Removal"
@@ -131,7 +153,10 @@ class DIMRED_OT_cancel(bpy.types.Operator):
 class DIMRED_OT_clear(bpy.types.Operator):
     bl_idname = "dimred.clear"
     bl_label = "Clear Removal"
-    bl_description = "Remove the difference layer from the world and show the original panorama again"
+    bl_description = (
+        "Remove the difference layer from the world and show the original panorama again; relocated "
+        "objects go back to where the panorama shows them"
+    )
     bl_options = {'REGISTER', 'UNDO'}
 
     @classmethod
@@ -148,6 +173,10 @@ class DIMRED_OT_clear(bpy.types.Operator):
 
     def execute(self, context: bpy.types.Context) -> set[str]:
         settings = context.scene.dimred
+        for entry in settings.removals:
+            obj = context.scene.objects.get(entry.object_name)
+            if entry.kind == 'RELOCATE' and obj is not None:
+                obj.matrix_world = entry.photographed_matrix()
         images = [world_layer.remove_layer(context.scene.world)] + [r.image for r in settings.removals]
         settings.removals.clear()
         for image in images:

@@ -1,11 +1,14 @@
-"""One Remove run inside Blender: gather on the main thread, compute, show, apply or roll back.
+"""One Remove or Relocate run inside Blender: gather on the main thread, compute, show, apply or
+roll back.
 
 `RemovalSession.begin` reads everything the engine needs from Blender (plain arrays, never a
-bpy object, go to the engine). `run_here` computes on the calling thread (background mode,
-scripts); `start` hands the work to a `Worker` thread and `tick`, called from a modal
-operator's timer, shows progress and previews and applies the result when it arrives. Every
-step that touches bpy runs on the main thread and is short: files are decoded and written by
-the worker, and the main thread only renames them into place and points images at them.
+bpy object, go to the engine); given a `Move`, the session relocates the object instead of
+removing it and, on success, places the object where the move puts it. `run_here` computes on
+the calling thread (background mode, scripts); `start` hands the work to a `Worker` thread and
+`tick`, called from a modal operator's timer, shows progress and previews and applies the
+result when it arrives. Every step that touches bpy runs on the main thread and is short:
+files are decoded and written by the worker, and the main thread only renames them into place
+and points images at them.
 
 Running sessions are kept in `_running` so that file load, unregister and Blender's exit can
 stop and join their threads (the one piece of module state; Blender cannot do it for us).
@@ -18,18 +21,21 @@ import os
 import shutil
 import tempfile
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
 import bpy
 import numpy as np
+from mathutils import Matrix
 
 from ..addon.errors import Cancelled, DimredError
 from ..addon.worker import Worker
 from . import world_layer
 
 if TYPE_CHECKING:  # the engine is imported only when a run starts
+    from ..addon.fixedview import Move
     from ..addon.removal_job import RemovalOutcome, RemovalRequest
+    from ..addon.scene import SceneData
 
 PREVIEW_IMAGE = "DimRed Preview"
 # Seconds a cancelled worker may take to notice; the engine checks far more often than this.
@@ -61,6 +67,22 @@ def own_filename(world: bpy.types.World, object_name: str) -> str:
 def probe_center(settings: bpy.types.PropertyGroup) -> tuple[float, float, float] | None:
     # None lets the bridge apply the contract's fallbacks (an Empty named ProbeCenter, the origin).
     return tuple(settings.probe_center) if settings.use_probe_center else None
+
+
+def photographed_matrix(settings: bpy.types.PropertyGroup, obj: bpy.types.Object) -> Matrix:
+    """Where the panorama shows `obj`: the matrix stored by its relocation, else where it is."""
+    index = _index(settings, obj.name)
+    entry = settings.removals[index] if index >= 0 else None
+    if entry is not None and entry.kind == 'RELOCATE':
+        return entry.photographed_matrix()
+    return obj.matrix_world.copy()
+
+
+def to_photographed(obj: bpy.types.Object, photographed: Matrix) -> np.ndarray | None:
+    """(4, 4) world transform from where `obj` is now to its photographed matrix; None when it
+    is there (exactly: no rounding through an inverse)."""
+    current, wanted = np.array(obj.matrix_world, dtype=np.float64), np.array(photographed, dtype=np.float64)
+    return None if np.array_equal(current, wanted) else wanted @ np.linalg.inv(current)
 
 
 def active() -> "RemovalSession | None":
@@ -101,6 +123,7 @@ class RemovalSession:
     request: "RemovalRequest"
     pack: bool
     relative: bool  # the output folder is given relative to the .blend
+    photographed: Matrix  # the object's world matrix where the panorama shows it
     temporary_folder: str = ""
     previous_layer: str = ""  # the image the world showed before, restored on cancel
     worker: Worker | None = None
@@ -114,13 +137,18 @@ class RemovalSession:
 
     # -- main thread: gather ------------------------------------------------------------
     @classmethod
-    def begin(cls, context: bpy.types.Context) -> "RemovalSession":
-        """Check the input and read the scene; DimredError says what is wrong (nothing changed)."""
+    def begin(cls, context: bpy.types.Context, move: "Move | None" = None) -> "RemovalSession":
+        """Check the input and read the scene; DimredError says what is wrong (nothing changed).
+
+        With `move`, the run relocates the marked object instead of removing it."""
         from ..addon import bridge
+        from ..addon.fixedview import check_move
         from ..addon.removal_job import RemovalRequest
 
         if active() is not None:
             raise DimredError("A removal is already running: wait for it or cancel it")
+        if move is not None:
+            check_move(move)
         scene = context.scene
         settings, world = scene.dimred, scene.world
         if world is None:
@@ -139,14 +167,20 @@ class RemovalSession:
             for name in names:
                 bridge.check_object(scene, name, purpose="used as a target surface")
             earlier = [r for r in settings.removals if r.object_name != target and r.image is not None]
-            scene_data = bridge.read_scene(scene, probe_center(settings),
-                                           exclude=[r.object_name for r in earlier], defer_file=True)
+            # Removed objects are gone from the room; relocated ones stand at their new place.
+            scene_data = bridge.read_scene(scene, probe_center(settings), defer_file=True,
+                                           exclude=[r.object_name for r in earlier if r.kind == 'REMOVE'])
+            obj = scene.objects[target]
+            photographed = photographed_matrix(settings, obj)
+            # The engine needs the object where the panorama shows it, also when an earlier
+            # relocation of it has moved it since.
+            scene_data = _placed(scene_data, target, to_photographed(obj, photographed))
             # Its shape is checked against the panorama's in the worker, where the panorama is read.
             base = _sum_images([r.image for r in earlier])
             request = RemovalRequest(
                 scene=scene_data, object_name=target, planes=names, quality=settings.quality, base=base,
                 own_path=os.path.join(folder, own_filename(world, target)),
-                layer_path=os.path.join(folder, layer_filename(world)), overrides=settings.overrides(),
+                layer_path=os.path.join(folder, layer_filename(world)), overrides=settings.overrides(), move=move,
             )
         except BaseException:
             if pack:
@@ -158,7 +192,7 @@ class RemovalSession:
         warnings = [f"'{', '.join(later)}' were removed after '{target}' with it still in place: "
                     "remove them again for the most accurate result"] if later else []
         return cls(scene_name=scene.name, world_name=world.name, object_name=target, request=request, pack=pack,
-                   relative=settings.output_dir.strip().startswith("//") and not pack,
+                   relative=settings.output_dir.strip().startswith("//") and not pack, photographed=photographed,
                    temporary_folder=folder if pack else "",
                    previous_layer=previous.name if previous is not None else "", warnings=warnings)
 
@@ -196,7 +230,7 @@ class RemovalSession:
             if isinstance(update.error, DimredError):
                 self._fail(context, str(update.error))
             elif update.error is not None:
-                self._fail(context, f"The removal failed: {type(update.error).__name__}: {update.error}")
+                self._fail(context, f"The {self.verb} failed: {type(update.error).__name__}: {update.error}")
             else:
                 self._apply(context, update.result)
             return 'FINISHED' if self.ok else 'CANCELLED'
@@ -214,6 +248,10 @@ class RemovalSession:
         if self.worker is not None:
             self.worker.stop(STOP_TIMEOUT)
         self._forget()
+
+    @property
+    def verb(self) -> str:
+        return "removal" if self.request.move is None else "relocation"
 
     # -- main thread: show and apply ----------------------------------------------------------
     def _world(self) -> bpy.types.World | None:
@@ -245,7 +283,7 @@ class RemovalSession:
         scene = bpy.data.scenes.get(self.scene_name)
         if world is None or scene is None:
             outcome.staged.discard()
-            return self._fail(context, "The scene or world was deleted while the removal ran")
+            return self._fail(context, f"The scene or world was deleted while the {self.verb} ran")
         try:
             outcome.staged.commit()
         except OSError as error:
@@ -263,14 +301,34 @@ class RemovalSession:
         entry = settings.removals[index] if index >= 0 else settings.removals.add()
         entry.object_name, entry.image = self.object_name, own
         report = dict(outcome.report)
+        self._place(scene, entry, report)
         report.setdefault("warnings", []).extend(self.warnings)
         report["layer"] = [r.object_name for r in settings.removals]
         settings.last_report = json.dumps(report)
         self.ok = True
         where = "packed into the .blend" if self.pack else f"wrote {request.layer_path}"
-        self.message = f"Removed '{self.object_name}': {report_summary(report)}; {where}"
+        done = f"Removed '{self.object_name}'" if request.move is None else (
+            f"Relocated '{self.object_name}' ({move_summary(report['relocation'])})")
+        self.message = f"{done}: {report_summary(report)}; {where}"
         _redraw(context)
         return True
+
+    def _place(self, scene: bpy.types.Scene, entry: bpy.types.PropertyGroup, report: dict) -> None:
+        """Record the move on the entry and put the object where the new panorama shows it:
+        moved from its photographed place, or back there when a relocated object is removed."""
+        move = self.request.move
+        relocated_before = entry.kind == 'RELOCATE'
+        entry.kind = 'REMOVE' if move is None else 'RELOCATE'
+        if move is None and not relocated_before:
+            return
+        placed = self.photographed
+        if move is not None:
+            entry.yaw, entry.distance_scale = move.yaw, move.distance_scale
+            entry.set_photographed_matrix(self.photographed)
+            placed = Matrix(report["relocation"]["matrix"]) @ self.photographed
+        obj = scene.objects.get(self.object_name)
+        if obj is not None:
+            obj.matrix_world = placed
 
     def _fail(self, context: bpy.types.Context | None, message: str) -> bool:
         """Put the world back as it was before this session and keep `message`."""
@@ -303,6 +361,24 @@ def report_summary(report: dict) -> str:
         if report.get(key):
             parts.append(f"{len(report[key])} {label}")
     return ", ".join(parts)
+
+
+def move_summary(relocation: dict) -> str:
+    """The move of a report's `relocation` entry in a few words."""
+    return (f"yaw {relocation['yaw']:.1f}°, distance ×{relocation['distance_scale']:.2f}, "
+            f"view elevation {relocation['elevation_change']:+.1f}°")
+
+
+def _placed(scene: "SceneData", name: str, transform: np.ndarray | None) -> "SceneData":
+    """`scene` with the triangles of object `name` moved by the (4, 4) world `transform`."""
+    from ..addon.fixedview import apply
+
+    if transform is None:
+        return scene
+    triangles = scene.triangles.copy()
+    mine = scene.tri_object == scene.object_index(name)
+    triangles[mine] = apply(transform, triangles[mine])
+    return replace(scene, triangles=triangles)
 
 
 def _index(settings: bpy.types.PropertyGroup, object_name: str) -> int:

@@ -12,6 +12,7 @@ from bpy.props import (
     PointerProperty,
     StringProperty,
 )
+from mathutils import Matrix
 
 QUALITY_ITEMS = (
     ("draft", "Draft", "Fewest patches, light senders and bounces: fastest, coarsest shadows and relighting"),
@@ -35,14 +36,57 @@ class DimredSurface(bpy.types.PropertyGroup):
     object: PointerProperty(name="Surface", type=bpy.types.Object, poll=_is_mesh)
 
 
-class DimredRemoval(bpy.types.PropertyGroup):
-    """One object removed from the panorama, in order, with its own difference image.
+def _yaw_property(description: str) -> FloatProperty:
+    # Degrees as a plain number, as the command line's --yaw takes it (an ANGLE property would
+    # hold radians for scripts).
+    return FloatProperty(name="Yaw", description=description, soft_min=-180.0, soft_max=180.0, precision=1)
 
-    The world layer shows the sum of all of them; a later removal works on HDRI + the earlier ones.
+
+def _distance_property(description: str) -> FloatProperty:
+    # No hard minimum: a factor <= 0 must reach the operator and be refused with a message,
+    # not be clamped silently into some other move.
+    return FloatProperty(name="Distance", description=description, default=1.0, soft_min=0.1, soft_max=4.0,
+                         step=1, precision=2)
+
+
+YAW_DESCRIPTION = ("Degrees the object turns about the vertical axis through the probe centre, counter-clockwise "
+                   "seen from above; its own orientation turns with it, so the photographed side keeps facing "
+                   "the probe")
+DISTANCE_DESCRIPTION = ("Factor on the object's horizontal distance from the probe centre (1 keeps it, 0.5 halves "
+                        "it); the object stays on its support plane")
+
+
+class DimredRemoval(bpy.types.PropertyGroup):
+    """One object removed from the panorama or relocated in it, in order, with its own
+    difference image.
+
+    The world layer shows the sum of all of them; a later removal works on HDRI + the earlier
+    ones. A relocated object stays in the geometry at its new place; `photographed` keeps where
+    the panorama shows it, which a new relocation starts from and Clear puts it back to.
     """
 
-    object_name: StringProperty(name="Object", description="The removed object")
+    object_name: StringProperty(name="Object", description="The removed or relocated object")
     image: PointerProperty(name="Difference", description="This removal's own difference image", type=bpy.types.Image)
+    kind: EnumProperty(
+        name="Kind",
+        items=(("REMOVE", "Removed", "The object was removed from the panorama"),
+               ("RELOCATE", "Relocated", "The object was moved to another place in the panorama")),
+        default="REMOVE",
+    )
+    yaw: _yaw_property(YAW_DESCRIPTION)
+    distance_scale: _distance_property(DISTANCE_DESCRIPTION)
+    photographed: FloatVectorProperty(
+        name="Photographed Matrix",
+        description="The object's world matrix where the panorama shows it, row by row",
+        size=16,
+        options={'HIDDEN'},
+    )
+
+    def photographed_matrix(self) -> Matrix:
+        return Matrix([self.photographed[row * 4:row * 4 + 4] for row in range(4)])
+
+    def set_photographed_matrix(self, matrix: Matrix) -> None:
+        self.photographed = [value for row in matrix for value in row]
 
 
 class DimredSettings(bpy.types.PropertyGroup):
@@ -117,6 +161,9 @@ class DimredSettings(bpy.types.PropertyGroup):
         name="Seed", min=0, default=0,
         description="Random seed of the fill: the same seed gives the same result, another seed another fill",
     )
+    yaw: _yaw_property(YAW_DESCRIPTION + ". Where Relocate starts; it keeps the last relocation's value")
+    distance_scale: _distance_property(DISTANCE_DESCRIPTION + ". Where Relocate starts; it keeps the last "
+                                       "relocation's value")
     storage: EnumProperty(
         name="Store Result",
         items=(
@@ -128,7 +175,7 @@ class DimredSettings(bpy.types.PropertyGroup):
     )
     removals: CollectionProperty(
         name="Removals",
-        description="The objects removed so far, in order; the world shows all of them",
+        description="The objects removed or relocated so far, in order; the world shows all of them",
         type=DimredRemoval,
     )
     last_report: StringProperty(

@@ -1,4 +1,4 @@
-"""Sidebar panels: the removal set-up and buttons, and a summary of the last run's report."""
+"""Sidebar panels: the removal and relocation set-up and buttons, and a summary of the last run's report."""
 from __future__ import annotations
 
 import json
@@ -56,7 +56,15 @@ class DIMRED_PT_main(bpy.types.Panel):
         column = layout.column(align=True)
         column.scale_y = 1.4
         if running is None:
-            column.operator("dimred.remove", icon='TRASH')
+            row = column.row(align=True)
+            row.operator("dimred.remove", icon='TRASH')
+            row.operator("dimred.relocate", text="Relocate...", icon='ORIENTATION_GIMBAL')
+            # The move by the values typed here, without the interactive tool.
+            row = layout.row(align=True)
+            row.prop(settings, "yaw", text="Yaw °")
+            row.prop(settings, "distance_scale", text="Distance ×")
+            apply = row.operator("dimred.relocate", text="", icon='CHECKMARK')
+            apply.yaw, apply.distance_scale = settings.yaw, settings.distance_scale
         else:
             row = column.row(align=True)
             row.progress(factor=running.fraction, type='BAR',
@@ -67,9 +75,13 @@ class DIMRED_PT_main(bpy.types.Panel):
         row.operator("dimred.save_hdri", icon='FILE_IMAGE')
         if len(settings.removals):
             column = layout.column(align=True)
-            column.label(text="Removed, in order:")
+            column.label(text="Removed or relocated, in order:")
             for entry in settings.removals:
-                column.label(text=entry.object_name, icon='GHOST_ENABLED')
+                if entry.kind == 'RELOCATE':
+                    column.label(text=f"{entry.object_name}: yaw {entry.yaw:.1f}°, distance ×{entry.distance_scale:.2f}",
+                                 icon='ORIENTATION_GIMBAL')
+                else:
+                    column.label(text=entry.object_name, icon='GHOST_ENABLED')
 
 
 class DIMRED_PT_parameters(bpy.types.Panel):
@@ -125,6 +137,8 @@ class DIMRED_PT_last_run(bpy.types.Panel):
             layout.label(text=line, icon='ERROR')
         for line in _lines(report.get("guards")):
             layout.label(text=line, icon='INFO')
+        if isinstance(report.get("relocation"), dict):
+            layout.label(text=f"Moved: {session.move_summary(report['relocation'])}", icon='ORIENTATION_GIMBAL')
 
 
 def _lines(entries: object) -> list[str]:

@@ -1,5 +1,6 @@
 """Shared fixtures: the repository imported the way Blender imports the installed extension,
-a fresh Blender session, and a Cycles render of the world as a lat-long panorama.
+a fresh Blender session, the tiny room saved as a .blend, and a Cycles render of the world as a
+lat-long panorama.
 
 Blender imports an extension as a package (`bl_ext.<repo>.diminished_reality`) whose modules
 use relative imports; here the repository root becomes the package `diminished_reality`.
@@ -109,3 +110,43 @@ def panorama_world(fresh_blender):
         return tree
 
     return build
+
+
+@pytest.fixture
+def room(registered, tmp_path: Path) -> Path:
+    """The tiny room saved as a .blend in tmp_path, with the box marked for removal (draft
+    quality); returns the HDRI's path."""
+    import bpy
+    import tiny_scene
+
+    hdri = tmp_path / "room.exr"
+    tiny_scene.write_exr(hdri, tiny_scene.synthetic_hdri(64, 32))
+    tiny_scene.build_scene(hdri)
+    bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "room.blend"))
+    settings = bpy.context.scene.dimred
+    settings.target = bpy.data.objects["Box"]
+    settings.quality = "draft"
+    return hdri
+
+
+@pytest.fixture
+def drive():
+    """A function that ticks a started RemovalSession the way the modal operator's timer does,
+    until it ends; returns its last state ('FINISHED' or 'CANCELLED')."""
+    import time
+
+    import bpy
+
+    def run(session, poll_interval: float = 0.01, timeout: float = 300.0, on_tick=None) -> str:
+        deadline = time.perf_counter() + timeout
+        while time.perf_counter() < deadline:
+            state = session.tick(bpy.context)
+            if on_tick is not None:
+                on_tick(session)
+            if state != 'RUNNING':
+                return state
+            time.sleep(poll_interval)
+        session.cancel(bpy.context)
+        raise AssertionError("the run did not finish")
+
+    return run

@@ -6,7 +6,8 @@ numpy 1.26), the oldest Blender the manifest claims. It builds the extension zip
 Blender's own `blender_ext.py` (or takes ZIP), installs and enables it into a throw-away user
 profile, and removes the box from a tiny procedural room twice: through the installed package's
 `blender -c dimred` command function and through `bpy.ops.dimred.remove`, whose world layer a
-Cycles render from the probe centre must show exactly; then undo, redo and clear.
+Cycles render from the probe centre must show exactly; then undo, redo and clear; and relocates
+the box with `bpy.ops.dimred.relocate`, which must move it and clear must put it back.
 Each step needs the ones before it, so the first failure ends the run. The closing line is
 `smoke: N passed, N failed`; the exit status is non-zero when a step failed.
 """
@@ -27,7 +28,7 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
 PACKAGE = "bl_ext.user_default.diminished_reality"
-OPERATORS = ("set_probe_center", "mark_remove", "mark_surface", "remove", "cancel", "clear", "save_hdri")
+OPERATORS = ("set_probe_center", "mark_remove", "mark_surface", "remove", "relocate", "cancel", "clear", "save_hdri")
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import tiny_scene  # noqa: E402  (next to this script, not a package)
@@ -152,6 +153,28 @@ def operator_run(blend: Path, hdri_path: Path) -> None:
     assert not world_layer.has_layer(scene.world)
 
 
+def relocate_run(blend: Path) -> None:
+    import bpy
+
+    world_layer = importlib.import_module(f"{PACKAGE}.operators.world_layer")
+    bpy.ops.wm.open_mainfile(filepath=str(blend))
+    scene = bpy.context.scene
+    scene.dimred.target = box = bpy.data.objects["Box"]
+    scene.dimred.quality = "draft"
+    photographed = box.matrix_world.copy()
+    assert bpy.ops.dimred.relocate(yaw=40.0, distance_scale=1.3) == {'FINISHED'}
+    difference = world_layer.image_rgb(world_layer.layer_image(scene.world))
+    assert np.isfinite(difference).all() and np.abs(difference).max() > 0, "the relocation changed nothing"
+    assert [(r.object_name, r.kind) for r in scene.dimred.removals] == [("Box", 'RELOCATE')]
+    # The box's centre (1, 0, 0.3) turned by 40 degrees about the probe's vertical axis, 1.3 times as far.
+    corners = np.array([tuple(box.matrix_world @ v.co) for v in box.data.vertices])
+    centre = 0.5 * (corners.min(axis=0) + corners.max(axis=0))
+    expected = (1.3 * np.cos(np.radians(40.0)), 1.3 * np.sin(np.radians(40.0)), 0.3)
+    np.testing.assert_allclose(centre, expected, atol=1e-5)
+    assert bpy.ops.dimred.clear() == {'FINISHED'}
+    np.testing.assert_allclose(np.array(box.matrix_world), np.array(photographed), atol=1e-6)
+
+
 def main(argv: list[str]) -> int:
     work = Path(tempfile.mkdtemp(prefix="dimred-smoke-"))
     # Before bpy is imported: Blender reads its user folders once, at start-up.
@@ -181,6 +204,7 @@ def main(argv: list[str]) -> int:
         blend, hdri_path = step("tiny scene opened", open_tiny_scene, work)
         step("blender -c dimred remove: files written and finite", command_run, command, work, hdri_path)
         step("bpy.ops.dimred.remove, Cycles render of the world, undo, redo, clear", operator_run, blend, hdri_path)
+        step("bpy.ops.dimred.relocate: the box moved and the layer written, clear puts it back", relocate_run, blend)
     except Exception:
         pass  # step() printed it; every later step depends on this one
     if failed:

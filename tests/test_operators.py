@@ -8,26 +8,12 @@ import json
 import threading
 import time
 import tracemalloc
-from pathlib import Path
 
 import bpy
 import numpy as np
 import pytest
 
 import tiny_scene
-
-
-@pytest.fixture
-def room(registered, tmp_path) -> Path:
-    """The tiny room saved as a .blend in tmp_path, with the box marked for removal."""
-    hdri = tmp_path / "room.exr"
-    tiny_scene.write_exr(hdri, tiny_scene.synthetic_hdri(64, 32))
-    tiny_scene.build_scene(hdri)
-    bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "room.blend"))
-    settings = bpy.context.scene.dimred
-    settings.target = bpy.data.objects["Box"]
-    settings.quality = "draft"
-    return hdri
 
 
 def test_remove_save_and_clear(room, tmp_path, extension):
@@ -82,21 +68,7 @@ def _links(world) -> set:
             for l in world.node_tree.links}
 
 
-def _drive(session, poll_interval: float = 0.01, timeout: float = 300.0, on_tick=None) -> str:
-    """Tick the session the way the modal operator's timer does, until it ends."""
-    deadline = time.perf_counter() + timeout
-    while time.perf_counter() < deadline:
-        state = session.tick(bpy.context)
-        if on_tick is not None:
-            on_tick(session)
-        if state != 'RUNNING':
-            return state
-        time.sleep(poll_interval)
-    session.cancel(bpy.context)
-    raise AssertionError("the removal did not finish")
-
-
-def test_threaded_removal_previews_then_applies(room, tmp_path, extension):
+def test_threaded_removal_previews_then_applies(room, tmp_path, extension, drive):
     from diminished_reality.operators import world_layer
 
     S = _session(extension)
@@ -105,7 +77,7 @@ def test_threaded_removal_previews_then_applies(room, tmp_path, extension):
     session.start()
     assert S.active() is session
     shown = []
-    state = _drive(session, on_tick=lambda s: shown.append(
+    state = drive(session, on_tick=lambda s: shown.append(
         world_layer.layer_image(world).name if world_layer.has_layer(world) else None))
     assert state == 'FINISHED', session.message
     # The coarse fill showed in the world before the result replaced it.

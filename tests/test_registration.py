@@ -8,7 +8,7 @@ from pathlib import Path
 import bpy
 import pytest
 
-OPERATORS = ("set_probe_center", "mark_remove", "mark_surface", "remove", "cancel", "clear", "save_hdri")
+OPERATORS = ("set_probe_center", "mark_remove", "mark_surface", "remove", "relocate", "cancel", "clear", "save_hdri")
 
 
 def _operator_exists(name: str) -> bool:
@@ -58,8 +58,8 @@ def test_operators_and_settings(registered):
         operator = getattr(bpy.ops.dimred, name)
         rna = operator.get_rna_type()
         assert rna.name and rna.description, name
-    # Relocation is a later issue: no half-finished operator ships before it.
-    assert not _operator_exists("relocate")
+    relocate = bpy.ops.dimred.relocate.get_rna_type().properties
+    assert relocate["yaw"].default == 0.0 and relocate["distance_scale"].default == 1.0
 
     settings = bpy.context.scene.dimred
     assert settings.quality == "balanced"
@@ -189,11 +189,12 @@ class _CheckingLayout:
         self._icon(kwargs)
         self.drawn.append(f"prop {name}")
 
-    def operator(self, idname: str, **kwargs) -> None:
+    def operator(self, idname: str, **kwargs) -> "_OperatorProperties":
         category, name = idname.split(".")
         assert hasattr(getattr(bpy.ops, category), name) and _operator_exists(name), idname
         self._icon(kwargs)
         self.drawn.append(f"operator {idname}")
+        return _OperatorProperties(getattr(getattr(bpy.ops, category), name).get_rna_type())
 
     def label(self, **kwargs) -> None:
         self._icon(kwargs)
@@ -202,6 +203,16 @@ class _CheckingLayout:
     def progress(self, factor: float, type: str, text: str) -> None:
         assert 0.0 <= factor <= 1.0 and type in {'BAR', 'RING'}
         self.drawn.append(f"progress {text}")
+
+
+class _OperatorProperties:
+    """Stands in for the properties a layout's operator button returns: only existing ones can be set."""
+
+    def __init__(self, rna) -> None:
+        object.__setattr__(self, "_rna", rna)
+
+    def __setattr__(self, name: str, value) -> None:
+        assert name in self._rna.properties, name
 
 
 def _draw(panel_class: type, context) -> list[str]:
@@ -216,9 +227,13 @@ def test_panels_draw_existing_properties_operators_and_icons(registered, monkeyp
 
     scene = bpy.context.scene
     scene.dimred.surfaces.add().object = _mesh("Floor")
+    for name, kind in (("Chair", 'REMOVE'), ("Box", 'RELOCATE')):
+        entry = scene.dimred.removals.add()
+        entry.object_name, entry.kind, entry.yaw, entry.distance_scale = name, kind, -40.0, 1.3
     drawn = _draw(sidebar.DIMRED_PT_main, bpy.context)
     assert {f"operator dimred.{name}" for name in OPERATORS if name != "cancel"} <= set(drawn)
     assert "label Floor" in drawn and "operator dimred.cancel" not in drawn
+    assert {"prop yaw", "prop distance_scale", "label Chair", "label Box: yaw -40.0°, distance ×1.30"} <= set(drawn)
 
     # While a removal runs, its progress bar and Cancel replace the Remove button.
     running = type("Running", (), {"stage": "first_order", "fraction": 0.375})()
@@ -231,11 +246,13 @@ def test_panels_draw_existing_properties_operators_and_icons(registered, monkeyp
     assert not sidebar.DIMRED_PT_last_run.poll(bpy.context)
     scene.dimred.last_report = (
         '{"seconds": {"shadows": 1.5, "total": 2.0}, "skipped": [{"stage": "synthesis", "reason": "not yet"}],'
-        ' "warnings": ["hidden region not filled"], "guards": {"reflectance_clamped_patches": 3}}'
+        ' "warnings": ["hidden region not filled"], "guards": {"reflectance_clamped_patches": 3},'
+        ' "relocation": {"yaw": 40.0, "distance_scale": 1.3, "elevation_change": 7.3}}'
     )
     assert sidebar.DIMRED_PT_last_run.poll(bpy.context)
     assert "prop override_parameters" in _draw(sidebar.DIMRED_PT_parameters, bpy.context)
     drawn = _draw(sidebar.DIMRED_PT_last_run, bpy.context)
     for line in ("label total: 2.00 s", "label Skipped synthesis: not yet", "label hidden region not filled",
-                 "label reflectance_clamped_patches: 3"):
+                 "label reflectance_clamped_patches: 3",
+                 "label Moved: yaw 40.0°, distance ×1.30, view elevation +7.3°"):
         assert line in drawn

@@ -1,0 +1,183 @@
+"""The Relocate operator: move the marked object under the fixed-view constraint (DESIGN 6).
+
+The move is a yaw about the vertical axis through the probe centre and a factor on the
+object's horizontal distance from it, both counted from where the panorama shows the object
+(its photographed place, kept by the list of removals once it has been relocated). The run
+itself is Remove's (`removal.RunOperator`): synchronous from scripts and in background mode,
+threaded with progress when the interactive tool confirms. On success the object stands at its
+new place, so the proxy geometry matches the new panorama and later removals see it there.
+
+Invoked from the UI without values, the operator first runs an interactive tool in the style
+of Blender's transform tools (`relocate_input`): the object follows the mouse in the viewport
+and the area header shows the move and the residual change of view elevation; Esc puts the
+object back exactly.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import bpy
+import numpy as np
+from bpy.props import FloatProperty
+from mathutils import Matrix
+
+from ..addon.errors import DimredError
+from . import session as S
+from .relocate_input import RelocateInput
+from .removal import RunOperator
+from .settings import DISTANCE_DESCRIPTION, YAW_DESCRIPTION
+
+if TYPE_CHECKING:  # the engine is imported only when a run starts
+    from ..addon.fixedview import Move
+
+# The channels that setting matrix_world rewrites: restored one by one, a cancel leaves the
+# object bit for bit as it was (a matrix would be decomposed again, with rounding).
+_TRANSFORM_CHANNELS = ("location", "rotation_euler", "rotation_quaternion", "rotation_axis_angle", "scale")
+
+
+@dataclass
+class Placement:
+    """Where the marked object may go: its photographed matrix, the probe centre and the
+    reference point whose distance the factor scales (as the engine computes them)."""
+
+    object_name: str
+    photographed: Matrix
+    center: np.ndarray
+    reference: np.ndarray
+
+    @classmethod
+    def of_target(cls, context: bpy.types.Context) -> "Placement":
+        """The placement of `scene.dimred.target`; DimredError when it cannot be moved."""
+        from ..addon import bridge
+        from ..addon.fixedview import apply, reference_point
+
+        scene, settings = context.scene, context.scene.dimred
+        obj = settings.target
+        bridge.check_object(scene, obj.name, purpose="relocated")
+        photographed = S.photographed_matrix(settings, obj)
+        points = bridge.object_points(scene, obj.name)
+        back = S.to_photographed(obj, photographed)
+        reference = reference_point(points if back is None else apply(back, points))
+        center = bridge.probe_center(scene, S.probe_center(settings))
+        return cls(obj.name, photographed, center, reference)
+
+    def matrix(self, move: "Move") -> Matrix:
+        """The object's world matrix after `move`."""
+        from ..addon.fixedview import move_matrix
+
+        return Matrix(move_matrix(self.center, self.reference, move).tolist()) @ self.photographed
+
+    def elevation_change(self, move: "Move") -> float:
+        from ..addon.fixedview import elevation_change
+
+        return elevation_change(self.center, self.reference, move)
+
+
+def snapshot(obj: bpy.types.Object) -> dict[str, tuple[float, ...]]:
+    """The transform channels that setting matrix_world rewrites, for `restore`."""
+    return {name: tuple(getattr(obj, name)) for name in _TRANSFORM_CHANNELS}
+
+
+def restore(obj: bpy.types.Object, saved: dict[str, tuple[float, ...]]) -> None:
+    for name, value in saved.items():
+        setattr(obj, name, value)
+
+
+def _move(yaw: float, distance_scale: float) -> "Move":
+    from ..addon.fixedview import Move
+
+    return Move(yaw=yaw, distance_scale=distance_scale)
+
+
+class DIMRED_OT_relocate(RunOperator, bpy.types.Operator):
+    bl_idname = "dimred.relocate"
+    bl_label = "Relocate Object"
+    bl_description = (
+        "Move the marked object in the panorama: turn it about the vertical axis through the probe centre "
+        "and scale its distance, so the photographed side keeps facing the probe. Interactive from the "
+        "panel (mouse, typed values, Enter/Esc); then computed in the background like Remove"
+    )
+    bl_options = {'REGISTER', 'UNDO'}
+
+    # SKIP_SAVE: values given explicitly skip the interactive tool, remembered ones must not.
+    yaw: FloatProperty(name="Yaw", description=YAW_DESCRIPTION, precision=1, options={'SKIP_SAVE'})
+    distance_scale: FloatProperty(name="Distance", description=DISTANCE_DESCRIPTION, default=1.0, precision=2,
+                                  step=1, options={'SKIP_SAVE'})
+
+    _tool: RelocateInput | None = None
+    _placement: Placement | None = None
+    _saved: dict | None = None  # the object's transform channels before the tool moved it
+
+    def move(self) -> "Move":
+        return _move(self.yaw, self.distance_scale)
+
+    def invoke(self, context: bpy.types.Context, event: bpy.types.Event) -> set[str]:
+        given = any(self.properties.is_property_set(name) for name in ("yaw", "distance_scale"))
+        if given or bpy.app.background or context.window is None:
+            return super().invoke(context, event)
+        try:
+            self._placement = Placement.of_target(context)
+        except DimredError as error:
+            self.report({'ERROR'}, str(error))
+            return {'CANCELLED'}
+        settings = context.scene.dimred
+        self._saved = snapshot(settings.target)
+        self._tool = RelocateInput.starting_at(settings.yaw, settings.distance_scale, (event.mouse_x, event.mouse_y))
+        self._show(context)
+        context.window_manager.modal_handler_add(self)
+        return {'RUNNING_MODAL'}
+
+    def modal(self, context: bpy.types.Context, event: bpy.types.Event) -> set[str]:
+        if self._tool is None:
+            return super().modal(context, event)  # the run after the tool confirmed
+        action = self._tool.handle(event)
+        if action == "PASS":
+            return {'PASS_THROUGH'}
+        if action == "UPDATE":
+            self._show(context)
+        elif action == "CANCEL":
+            self._end_tool(context)
+            return {'CANCELLED'}
+        elif action == "CONFIRM":
+            self.yaw, self.distance_scale = self._tool.yaw, self._tool.distance_scale
+            # The run starts from the scene as it was: the object moves when the result is applied.
+            self._end_tool(context)
+            return {'RUNNING_MODAL'} if self._launch(context) else {'CANCELLED'}
+        return {'RUNNING_MODAL'}
+
+    def cancel(self, context: bpy.types.Context) -> None:
+        if self._tool is not None:
+            self._end_tool(context)
+        super().cancel(context)
+
+    def _finish(self, run: S.RemovalSession, ok: bool, context: bpy.types.Context | None = None) -> set[str]:
+        if ok:
+            # The panel's fields keep the last relocation, where the tool starts next time.
+            settings = bpy.data.scenes[run.scene_name].dimred
+            settings.yaw, settings.distance_scale = self.yaw, self.distance_scale
+        return super()._finish(run, ok, context)
+
+    def _show(self, context: bpy.types.Context) -> None:
+        """Put the object where the tool's values take it and say so in the header."""
+        tool, placement = self._tool, self._placement
+        elevation = None
+        if not tool.error:
+            move = _move(tool.yaw, tool.distance_scale)
+            context.scene.objects[placement.object_name].matrix_world = placement.matrix(move)
+            elevation = placement.elevation_change(move)
+        if context.area is not None:
+            context.area.header_text_set(tool.header(placement.object_name, elevation))
+
+    def _end_tool(self, context: bpy.types.Context) -> None:
+        obj = context.scene.objects.get(self._placement.object_name)
+        if obj is not None:
+            restore(obj, self._saved)
+        if context.area is not None:
+            context.area.header_text_set(None)
+        self._tool = self._placement = self._saved = None
+
+
+classes = (DIMRED_OT_relocate,)
+
+register, unregister = bpy.utils.register_classes_factory(classes)
