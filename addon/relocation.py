@@ -117,16 +117,36 @@ def _collisions(before: np.ndarray, after: np.ndarray, others: np.ndarray, other
             continue
         tris = others[other_ids == k]
         occ = Occluders(tris, other_ids[other_ids == k], eps)
+        # Inside and outside mean something for a closed mesh only (a ceiling with lamp holes
+        # is crossed once or not at all, wherever one stands).
+        closed = _closed(tris, eps)
 
         def collides(obj: np.ndarray) -> bool:
             a = obj.reshape(-1, 3)
             b = np.roll(obj, -1, axis=1).reshape(-1, 3)
-            inside = crossings(fixedview.reference_point(obj)[None], up, tris)[0] % 2 == 1
+            inside = closed and crossings(fixedview.reference_point(obj)[None], up, tris)[0] % 2 == 1
             return bool(inside or occ.blocked(a, b).any())
 
         if collides(after) and not collides(before):
             found.append(int(k))
     return found
+
+
+def _closed(triangles: np.ndarray, eps: float) -> bool:
+    """Whether the triangles form closed surfaces: every edge shared by an even number of them."""
+    keys = np.round(triangles / max(eps, 1e-12)).astype(np.int64)
+    a, b = keys.reshape(-1, 3), np.roll(keys, -1, axis=1).reshape(-1, 3)
+    edges = np.where(_less(a, b)[:, None], np.concatenate([a, b], axis=1), np.concatenate([b, a], axis=1))
+    _, counts = np.unique(edges, axis=0, return_counts=True)
+    return bool((counts % 2 == 0).all())
+
+
+def _less(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """(N,) whether rows a are lexicographically before rows b."""
+    diff = a != b
+    first = diff.argmax(axis=1)
+    rows = np.arange(len(a))
+    return diff.any(axis=1) & (a[rows, first] < b[rows, first])
 
 
 def _map_rows(old: Geometry, new: Geometry, tri_new: np.ndarray) -> np.ndarray:
