@@ -22,17 +22,7 @@ from addon.pipeline import remove_object
 
 @pytest.fixture(scope="module")
 def tiny(tmp_path_factory):
-    import bpy
-
-    from addon import bridge
-
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    hdri = tmp_path_factory.mktemp("tiny") / "room.exr"
-    tiny_scene.write_exr(hdri, tiny_scene.synthetic_hdri(64, 32))
-    tiny_scene.build_scene(hdri)
-    scene = bridge.read_scene(bpy.context.scene)
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    return scene
+    return tiny_scene.scene_data(tmp_path_factory.mktemp("tiny"), 64, 32)
 
 
 @pytest.fixture(scope="module")

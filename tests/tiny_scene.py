@@ -174,3 +174,20 @@ def render_world(width: int, height: int, origin, path: str | Path) -> np.ndarra
     bpy.data.objects.remove(camera)
     bpy.data.cameras.remove(camera_data)
     return read_exr(path)
+
+
+def scene_data(folder: str | Path, width: int, height: int):
+    """The room as the engine sees it (`addon.scene.SceneData`), read through the bridge from a
+    scene built in a fresh Blender session with a `width` x `height` panorama in `folder`; the
+    session is emptied again afterwards."""
+    import bpy
+
+    from addon import bridge
+
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    hdri = Path(folder) / "room.exr"
+    write_exr(hdri, synthetic_hdri(width, height))
+    build_scene(hdri)
+    scene = bridge.read_scene(bpy.context.scene)
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    return scene
