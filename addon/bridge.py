@@ -68,14 +68,6 @@ def read_scene(scene: bpy.types.Scene, center: Sequence[float] | None = None,
     )
 
 
-def object_points(scene: bpy.types.Scene, name: str) -> np.ndarray:
-    """(N, 3) world-space corners of the triangles `read_scene` reads for object `name` (its
-    evaluated mesh), e.g. for the reference point of a relocation before the engine runs."""
-    _view_layer(scene).update()
-    evaluated = scene.objects[name].evaluated_get(_view_layer(scene).depsgraph)
-    return _object_triangles(evaluated).reshape(-1, 3)
-
-
 def check_object(scene: bpy.types.Scene, name: str, purpose: str = "removed") -> None:
     """DimredError unless `name` is a render-visible mesh of `scene`.
 

@@ -66,22 +66,23 @@ def place(scene: SceneData, target: int, move: Move) -> Placement:
     size = float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0)))
     height = float(np.ptp(pts[:, 2]))
     scene_size = float(np.ptp(tris.reshape(-1, 3), axis=0).max())
-    lift = 1e-3 * max(size, 1e-9)
-    tolerance = lift + _SUPPORT_GAP * max(height, size * 1e-2)
+    # A foot stands on a surface within `gap` above or below it: proxies are modelled by hand,
+    # sunk into the floor a little or floating above it.
+    gap = _SUPPORT_GAP * max(height, size * 1e-2)
 
     feet = np.unique(pts[pts[:, 2] <= pts[:, 2].min() + 1e-2 * max(height, 1e-9)], axis=0)
     down = np.broadcast_to([0.0, 0.0, -1.0], feet.shape)
-    hit, t = first_hits(feet + [0.0, 0.0, lift], down, others)
-    stands = t <= tolerance
+    hit, t = first_hits(feet + [0.0, 0.0, gap], down, others)
+    stands = t <= 2.0 * gap
     if not stands.any():
         raise DimredError(
-            f"'{name}' does not stand on a surface (nothing within {tolerance:.3g} below its lowest points): a "
+            f"'{name}' does not stand on a surface (nothing within {gap:.3g} of its lowest points): a "
             "relocation keeps an object on its support plane, so model the surface it stands on"
         )
     support_ids = np.unique(other_ids[hit[stands]])
     new_feet = fixedview.apply(matrix, feet[stands])
-    hit_new, t_new = first_hits(new_feet + [0.0, 0.0, lift], down[: len(new_feet)], others)
-    off = ~((t_new <= tolerance) & np.isin(other_ids[np.maximum(hit_new, 0)], support_ids))
+    hit_new, t_new = first_hits(new_feet + [0.0, 0.0, gap], down[: len(new_feet)], others)
+    off = ~((t_new <= 2.0 * gap) & np.isin(other_ids[np.maximum(hit_new, 0)], support_ids))
     support = [scene.object_names[k] for k in support_ids]
     if off.any():
         below = sorted({scene.object_names[other_ids[k]] for k in hit_new[off] if k >= 0})

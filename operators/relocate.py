@@ -30,6 +30,7 @@ from .settings import DISTANCE_DESCRIPTION, YAW_DESCRIPTION
 
 if TYPE_CHECKING:  # the engine is imported only when a run starts
     from ..addon.fixedview import Move
+    from ..addon.scene import SceneData
 
 # The channels that setting matrix_world rewrites: restored one by one, a cancel leaves the
 # object bit for bit as it was (a matrix would be decomposed again, with rounding).
@@ -45,28 +46,39 @@ class Placement:
     photographed: Matrix
     center: np.ndarray
     reference: np.ndarray
+    scene: "SceneData"  # the geometry as the engine will see it, for `refusal`
 
     @classmethod
     def of_target(cls, context: bpy.types.Context) -> "Placement":
         """The placement of `scene.dimred.target`; DimredError when it cannot be moved."""
         from ..addon import bridge
-        from ..addon.fixedview import apply, reference_point
+        from ..addon.fixedview import reference_point
 
         scene, settings = context.scene, context.scene.dimred
         obj = settings.target
         bridge.check_object(scene, obj.name, purpose="relocated")
-        photographed = S.photographed_matrix(settings, obj)
-        points = bridge.object_points(scene, obj.name)
-        back = S.to_photographed(obj, photographed)
-        reference = reference_point(points if back is None else apply(back, points))
-        center = bridge.probe_center(scene, S.probe_center(settings))
-        return cls(obj.name, photographed, center, reference)
+        data = S.engine_scene(scene, obj.name)
+        reference = reference_point(data.triangles[data.tri_object == data.object_index(obj.name)])
+        return cls(obj.name, S.photographed_matrix(settings, obj), data.center, reference, data)
 
     def matrix(self, move: "Move") -> Matrix:
         """The object's world matrix after `move`."""
         from ..addon.fixedview import move_matrix
 
         return Matrix(move_matrix(self.center, self.reference, move).tolist()) @ self.photographed
+
+    def refusal(self, move: "Move") -> str:
+        """Why the engine would refuse `move` (off the support surface, into a wall or another
+        object), or '': checked as the mouse moves, so the tool never confirms a place the run
+        would refuse."""
+        from ..addon.errors import DimredError
+        from ..addon.relocation import place
+
+        try:
+            place(self.scene, self.scene.object_index(self.object_name), move)
+        except DimredError as error:
+            return str(error)
+        return ""
 
     def elevation_change(self, move: "Move") -> float:
         from ..addon.fixedview import elevation_change
@@ -162,8 +174,10 @@ class DIMRED_OT_relocate(RunOperator, bpy.types.Operator):
         """Put the object where the tool's values take it and say so in the header."""
         tool, placement = self._tool, self._placement
         elevation = None
+        tool.refusal = ""
         if not tool.error:
             move = _move(tool.yaw, tool.distance_scale)
+            tool.refusal = placement.refusal(move)
             context.scene.objects[placement.object_name].matrix_world = placement.matrix(move)
             elevation = placement.elevation_change(move)
         if context.area is not None:

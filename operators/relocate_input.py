@@ -61,6 +61,7 @@ class RelocateInput:
     texts: list[str] = field(default_factory=lambda: ["", ""])
     snap: bool = False
     fine: bool = False
+    refusal: str = ""  # why the place the values lead to breaks the constraint (the operator checks it)
 
     @classmethod
     def starting_at(cls, yaw: float, distance_scale: float, mouse: tuple[int, int] | None = None) -> "RelocateInput":
@@ -94,7 +95,7 @@ class RelocateInput:
             return "the yaw must be a finite angle"
         if not (math.isfinite(self.distance_scale) and self.distance_scale > 0.0):
             return "the distance factor must be greater than 0"
-        return ""
+        return self.refusal
 
     def _step(self, index: int) -> float:
         return (FINE_SNAP if self.fine else SNAP)[index]

@@ -85,6 +85,24 @@ def to_photographed(obj: bpy.types.Object, photographed: Matrix) -> np.ndarray |
     return None if np.array_equal(current, wanted) else wanted @ np.linalg.inv(current)
 
 
+def _earlier(settings: bpy.types.PropertyGroup, target: str) -> list:
+    """The list's entries of other objects that have a result."""
+    return [r for r in settings.removals if r.object_name != target and r.image is not None]
+
+
+def engine_scene(scene: bpy.types.Scene, target: str) -> "SceneData":
+    """The scene as the engine must see it for a run on `target`: earlier removed objects gone
+    from the room, relocated ones at their new place, and `target` where the panorama shows it
+    (also when an earlier relocation of it has moved it since); the panorama's pixels deferred."""
+    from ..addon import bridge
+
+    settings = scene.dimred
+    removed = [r.object_name for r in _earlier(settings, target) if r.kind == 'REMOVE']
+    scene_data = bridge.read_scene(scene, probe_center(settings), defer_file=True, exclude=removed)
+    obj = scene.objects[target]
+    return _placed(scene_data, target, to_photographed(obj, photographed_matrix(settings, obj)))
+
+
 def active() -> "RemovalSession | None":
     """The session that is computing now, if any."""
     return next((s for s in _running if s.worker is not None and not s.done), None)
@@ -166,15 +184,9 @@ class RemovalSession:
             names = settings.surface_names()
             for name in names:
                 bridge.check_object(scene, name, purpose="used as a target surface")
-            earlier = [r for r in settings.removals if r.object_name != target and r.image is not None]
-            # Removed objects are gone from the room; relocated ones stand at their new place.
-            scene_data = bridge.read_scene(scene, probe_center(settings), defer_file=True,
-                                           exclude=[r.object_name for r in earlier if r.kind == 'REMOVE'])
-            obj = scene.objects[target]
-            photographed = photographed_matrix(settings, obj)
-            # The engine needs the object where the panorama shows it, also when an earlier
-            # relocation of it has moved it since.
-            scene_data = _placed(scene_data, target, to_photographed(obj, photographed))
+            earlier = _earlier(settings, target)
+            scene_data = engine_scene(scene, target)
+            photographed = photographed_matrix(settings, scene.objects[target])
             # Its shape is checked against the panorama's in the worker, where the panorama is read.
             base = _sum_images([r.image for r in earlier])
             request = RemovalRequest(

@@ -150,3 +150,12 @@ def test_header_shows_values_active_field_typed_text_and_keys():
     _type(tool, "\t-")
     assert "yaw 40.0°, distance [\u2212|]" in tool.header("Box", None)
     assert "view elevation" not in tool.header("Box", None)
+
+
+def test_a_refused_place_cannot_be_confirmed_and_the_header_says_why():
+    tool = ri.RelocateInput()
+    tool.refusal = "at the new place 'Box' would cut through 'Wall'"
+    assert tool.handle(Event("RET")) == "NONE"
+    assert "would cut through 'Wall'" in tool.header("Box", 1.0)
+    tool.refusal = ""
+    assert tool.handle(Event("RET")) == "CONFIRM"

@@ -210,3 +210,24 @@ def test_the_interactive_tool_moves_the_box_and_cancel_restores_it_exactly(room,
 
     relocate.DIMRED_OT_relocate._end_tool(tool, bpy.context)
     assert relocate.snapshot(box) == before
+
+
+def test_the_interactive_tool_refuses_to_confirm_a_place_the_engine_would_refuse(room, extension):
+    """Checked as the mouse moves: the header says why, and Enter does nothing until the values
+    lead to an allowed place."""
+    from diminished_reality.operators import relocate
+    from diminished_reality.operators.relocate_input import RelocateInput
+
+    box = bpy.data.objects["Box"]
+    before = relocate.snapshot(box)
+    placement = relocate.Placement.of_target(bpy.context)
+    tool = SimpleNamespace(_tool=RelocateInput.starting_at(0.0, 2.0), _placement=placement, _saved=before)
+    relocate.DIMRED_OT_relocate._show(tool, bpy.context)
+    assert "would not stand on 'Floor'" in tool._tool.refusal
+    enter = SimpleNamespace(type="RET", value="PRESS", mouse_x=0, mouse_y=0, shift=False, ctrl=False)
+    assert tool._tool.handle(enter) == "NONE"
+    tool._tool = RelocateInput.starting_at(*MOVE)
+    relocate.DIMRED_OT_relocate._show(tool, bpy.context)
+    assert tool._tool.refusal == "" and tool._tool.handle(enter) == "CONFIRM"
+    relocate.DIMRED_OT_relocate._end_tool(tool, bpy.context)
+    assert relocate.snapshot(box) == before
