@@ -112,7 +112,9 @@ class _Removal:
         pixel = float(np.linalg.norm(self.obj_centre)) * np.pi / self.height
         self.fine_cell = min(self.obj_radius / self.params.fine_cells, self.params.fine_pixels * pixel)
 
-    def trace(self) -> None:
+    def trace(self, silhouette: bool = True) -> None:
+        """What each pixel sees; with `silhouette`, the pixels around the object count as
+        hidden too (they are filled, not relit)."""
         hits = trace_panorama(self.geo.triangles, self.width, self.height)
         self.hits = hits
         flat_tri = hits.tri.ravel()
@@ -123,8 +125,10 @@ class _Removal:
         # scale the object's share of it too, so it is filled like the pixels the object covers.
         on_object = np.zeros(self.height * self.width, dtype=bool)
         on_object[self.hp[self.obj_h == self.target]] = True
-        silhouette = latlong.dilate(on_object.reshape(self.height, self.width), 1).ravel()
-        self.hidden_h = silhouette[self.hp]
+        hidden = on_object.reshape(self.height, self.width)
+        if silhouette:
+            hidden = latlong.dilate(hidden, 1)
+        self.hidden_h = hidden.ravel()[self.hp]
         hidden_map = np.zeros(self.height * self.width, dtype=bool)
         hidden_map[self.hp[self.hidden_h]] = True
         self.hidden_map = hidden_map.reshape(self.height, self.width)
@@ -646,10 +650,12 @@ class Solution:
 
 
 def solve(scene: SceneData, object_name: str, planes: list[str] | tuple[str, ...], params: Params, rep: Report,
-          cancel: Callable[[], bool] | None = None, traced: Callable[[_Removal], None] | None = None) -> Solution:
+          cancel: Callable[[], bool] | None = None, traced: Callable[[_Removal], None] | None = None,
+          silhouette: bool = True) -> Solution:
     """Every stage of the removal up to the new irradiance of each pixel (DESIGN 3, steps 1-5
     and 8); the stages are timed in `rep`. `traced(job)` is called once the pixels are traced,
-    before the panorama is read as radiosity (it may change `job.hdri`)."""
+    before the panorama is read as radiosity (it may change `job.hdri`). Without `silhouette`
+    the pixels around the object are relit like the rest (an insertion has nothing to fill)."""
     check = _cancel_check(cancel)
     if object_name not in scene.object_names:
         raise DimredError(f"no mesh object named '{object_name}' among the scene's proxy geometry")
@@ -670,7 +676,7 @@ def solve(scene: SceneData, object_name: str, planes: list[str] | tuple[str, ...
     job = _Removal(scene, target, plane_ids, params, rep, cancel)
     job.geometry(geo)
     with rep.stage("trace"):
-        job.trace()
+        job.trace(silhouette)
     if traced is not None:
         traced(job)
     check()

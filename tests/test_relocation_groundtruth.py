@@ -25,7 +25,8 @@ from scenes.render import REPO, load_pair, render_pair
 BOUND = 0.4
 FAR_DAMAGE = 0.08
 CASES = [("basic_box", 40.0, 1.3), ("stool", 40.0, 1.3), ("rotated_world", -40.0, 1.3),
-         ("wall_contact", -40.0, 1.3), ("red_box", 25.0, 0.8), ("second_object", -40.0, 1.3)]
+         ("wall_contact", -40.0, 1.3), ("red_box", 25.0, 0.8), ("second_object", -40.0, 1.3),
+         ("bright_lamp", 40.0, 1.3), ("seam", 40.0, 1.3), ("nadir", 40.0, 1.3)]
 
 
 def _relocate(tmp_path, blend, name: str, *arguments: str) -> subprocess.CompletedProcess:
