@@ -204,6 +204,10 @@ def _carry(old: Solution, job: _Removal, photo: np.ndarray, rep: Report) -> _Car
     pix = job.hp[on]
     tri_new = job.tri_h[on]
     bary = job.hits.bary.reshape(-1, 2)[pix]
+    if not len(pix):
+        rep.warn(f"at the new place '{job.geo.object_names[job.target]}' is hidden from the probe: only its shadow "
+                 "and reflected light change the panorama")
+        return _Carried(pix, tri_new, bary, np.zeros((0, 3)), np.zeros((0, 3)))
     tri_old = _map_rows(old.job.geo, job.geo, tri_new)
     known = tri_old >= 0
     radiance = np.zeros((len(pix), 3))
@@ -302,7 +306,8 @@ def relocate(
             ratio = np.clip(ratio, 0.0, _RATIO_MAX)
             updated[job.hp[room]] = without[job.hp[room]] * ratio
             obj = carried[0]
-            updated[obj.pix] = obj.rho * new.irradiance(obj.tri, obj.bary) / np.pi
+            if len(obj.pix):
+                updated[obj.pix] = obj.rho * new.irradiance(obj.tri, obj.bary) / np.pi
             y_new, y_without = updated @ LUMA, without @ LUMA
             # The share of the insertion's change that this pass still changed: how far from its fixed point.
             residuals.append(float(np.abs(y_new - current @ LUMA).sum() / max(float(np.abs(y_new - y_without).sum()), 1e-30)))

@@ -103,3 +103,18 @@ def test_a_proxy_sunk_into_the_floor_or_floating_a_little_still_stands_on_it(tin
     """Hand-modelled proxies are rarely exact: within 2 % of the object's height counts as standing."""
     scene = _floating(tiny, offset)
     assert place(scene, scene.object_names.index("Box"), Move(45.0, 1.1)).support == ["Floor"]
+
+
+def test_a_new_place_hidden_from_the_probe_still_casts_its_shadow(tiny):
+    """Behind a tall cabinet the box shows no pixel; the room still gets its new shadow."""
+    lo, hi = (-0.5, -0.5, 0.0), (-0.4, 0.5, 1.6)
+    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+    faces = [(0, 1, 3), (0, 3, 2), (4, 6, 7), (4, 7, 5), (0, 4, 5), (0, 5, 1), (2, 3, 7), (2, 7, 6),
+             (0, 2, 6), (0, 6, 4), (1, 5, 7), (1, 7, 3)]
+    scene = replace(tiny, triangles=np.concatenate([tiny.triangles, corners[np.array(faces)]]),
+                    tri_object=np.concatenate([tiny.tri_object, np.full(len(faces), len(tiny.object_names))]),
+                    object_names=[*tiny.object_names, "Cabinet"])
+    result = relocate_object(scene, "Box", Move(180.0, 1.0), quality="draft")
+    assert result.report["relocation"]["object_pixels"] == 0
+    assert any("hidden from the probe" in w for w in result.report["warnings"])
+    assert np.isfinite(result.difference).all()
