@@ -292,7 +292,7 @@ def relocate(
         step = Report(_scaled(progress, share * (k + 1), share * (k + 2), f"insertion {k + 1}/{passes}: "), stages=7)
         image = current.reshape(photo.shape).astype(np.float32)
         new = solve(replace(moved_scene, hdri=image), object_name, planes, params, step, cancel,
-                    traced=None if carried else first_guess, silhouette=False)
+                    traced=None if carried else first_guess, fill=False)
         with insertion.stage("insertion"):
             updated = without.copy()
             job = new.job

@@ -112,9 +112,9 @@ class _Removal:
         pixel = float(np.linalg.norm(self.obj_centre)) * np.pi / self.height
         self.fine_cell = min(self.obj_radius / self.params.fine_cells, self.params.fine_pixels * pixel)
 
-    def trace(self, silhouette: bool = True) -> None:
-        """What each pixel sees; with `silhouette`, the pixels around the object count as
-        hidden too (they are filled, not relit)."""
+    def trace(self, fill: bool = True) -> None:
+        """What each pixel sees. With `fill` (a removal), the pixels around the object count as
+        hidden too (they are filled, not relit), and what is behind the hidden ones is traced."""
         hits = trace_panorama(self.geo.triangles, self.width, self.height)
         self.hits = hits
         flat_tri = hits.tri.ravel()
@@ -126,7 +126,7 @@ class _Removal:
         on_object = np.zeros(self.height * self.width, dtype=bool)
         on_object[self.hp[self.obj_h == self.target]] = True
         hidden = on_object.reshape(self.height, self.width)
-        if silhouette:
+        if fill:
             hidden = latlong.dilate(hidden, 1)
         self.hidden_h = hidden.ravel()[self.hp]
         hidden_map = np.zeros(self.height * self.width, dtype=bool)
@@ -141,7 +141,7 @@ class _Removal:
         self.tri_without = np.full(self.height * self.width, -1, dtype=np.int64)
         self.distance_without = np.zeros(self.height * self.width)
         self.revealed = np.zeros(0, dtype=np.int64)
-        if self.hidden_h.any():
+        if fill and self.hidden_h.any():
             # What the probe would see where the object was: the surfaces to fill.
             keep = np.flatnonzero(self.geo.tri_object != self.target)
             behind = trace_panorama(self.geo.triangles[keep], self.width, self.height)
@@ -651,11 +651,11 @@ class Solution:
 
 def solve(scene: SceneData, object_name: str, planes: list[str] | tuple[str, ...], params: Params, rep: Report,
           cancel: Callable[[], bool] | None = None, traced: Callable[[_Removal], None] | None = None,
-          silhouette: bool = True) -> Solution:
+          fill: bool = True) -> Solution:
     """Every stage of the removal up to the new irradiance of each pixel (DESIGN 3, steps 1-5
     and 8); the stages are timed in `rep`. `traced(job)` is called once the pixels are traced,
-    before the panorama is read as radiosity (it may change `job.hdri`). Without `silhouette`
-    the pixels around the object are relit like the rest (an insertion has nothing to fill)."""
+    before the panorama is read as radiosity (it may change `job.hdri`). Without `fill` (an
+    insertion has nothing to fill) the pixels around the object are relit like the rest."""
     check = _cancel_check(cancel)
     if object_name not in scene.object_names:
         raise DimredError(f"no mesh object named '{object_name}' among the scene's proxy geometry")
@@ -676,7 +676,7 @@ def solve(scene: SceneData, object_name: str, planes: list[str] | tuple[str, ...
     job = _Removal(scene, target, plane_ids, params, rep, cancel)
     job.geometry(geo)
     with rep.stage("trace"):
-        job.trace(silhouette)
+        job.trace(fill)
     if traced is not None:
         traced(job)
     check()
