@@ -340,6 +340,22 @@ def _second_object() -> SceneSpec:
     )
 
 
+def _shadowed_box() -> SceneSpec:
+    room = Room(lo=(-2.0, -2.0, 0.0), hi=(2.6, 2.6, 2.7), floor=Floor("noise", (0.55, 0.5, 0.45), (0.7, 0.66, 0.6), 0.2))
+    # A tall cabinet stands between the main lamp and the box: the photograph shows the box in
+    # the cabinet's shadow, and a relocation that takes it out of the shadow must brighten it.
+    return SceneSpec(
+        name="shadowed_box",
+        room=room,
+        lamps=(Lamp((2.2, -0.3), (0.5, 0.5), 40.0), Lamp((-1.2, -1.2), (0.4, 0.4), 8.0)),
+        objects=(SceneObject("Box", "box", (0.5, 0.5, 0.5), _on_floor(room, 1.1, 0.8), (0.6, 0.55, 0.4),
+                             rotation_z=10.0),
+                 SceneObject("Cabinet", "box", (0.4, 0.4, 1.8), _on_floor(room, 1.7, 0.2), (0.5, 0.5, 0.55))),
+        probe=(0.0, 0.0, 1.5),
+        remove="Box",
+    )
+
+
 def _tiny_lamp() -> SceneSpec:
     room = Room(lo=(-2.0, -2.4, 0.0), hi=(2.6, 2.0, 2.5),
                 floor=Floor("checker", (0.5, 0.48, 0.45), (0.28, 0.27, 0.25), 0.35))
@@ -444,6 +460,7 @@ SPECS: dict[str, SceneSpec] = {s.name: s for s in (
     _nadir(),
     _basic_box("rotated_world", world_rotation_z=70.0),
     _second_object(),
+    _shadowed_box(),
     _tiny_lamp(),
     _dark_floor(),
     _white_floor(),
