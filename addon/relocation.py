@@ -79,24 +79,31 @@ def place(scene: SceneData, target: int, move: Move) -> Placement:
             f"'{name}' does not stand on a surface (nothing within {gap:.3g} of its lowest points): a "
             "relocation keeps an object on its support plane, so model the surface it stands on"
         )
-    support_ids = np.unique(other_ids[hit[stands]])
     new_feet = fixedview.apply(matrix, feet[stands])
     hit_new, t_new = first_hits(new_feet + [0.0, 0.0, gap], down[: len(new_feet)], others)
-    off = ~((t_new <= 2.0 * gap) & np.isin(other_ids[np.maximum(hit_new, 0)], support_ids))
-    support = [scene.object_names[k] for k in support_ids]
+    # The support is a plane, not an object: a floor modelled in pieces, or a rug on it, holds
+    # the object as well at the same height.
+    off = t_new > 2.0 * gap
     if off.any():
+        was_on = ", ".join(repr(scene.object_names[k]) for k in np.unique(other_ids[hit[stands]]))
         below = sorted({scene.object_names[other_ids[k]] for k in hit_new[off] if k >= 0})
-        where = f"over {', '.join(repr(n) for n in below)}" if below else "over nothing"
+        where = f"over {', '.join(repr(n) for n in below)} at another height" if below else "over nothing"
         raise DimredError(
-            f"at the new place '{name}' would not stand on {', '.join(repr(n) for n in support)}: "
+            f"at the new place '{name}' would not stand on its support plane (where {was_on} holds it now): "
             f"{int(off.sum())} of its feet would be {where}. Choose a smaller move"
         )
+    support = [scene.object_names[k] for k in np.unique(other_ids[hit_new])]
 
     new_pts = moved[rows].reshape(-1, 3)
     centre = np.asarray(scene.center, dtype=np.float64)
     if np.all(new_pts.min(axis=0) < centre) and np.all(new_pts.max(axis=0) > centre):
         raise DimredError(f"at the new place '{name}' would enclose the probe centre")
-    collided = _collisions(obj, moved[rows], others, other_ids, support_ids, 1e-6 * max(scene_size, 1e-9))
+    # The object's bottom, lifted by the gap, may touch nothing (the support included: a foot
+    # inside a cabinet finds the cabinet's bottom below it, but that is no support).
+    floor_z = pts[:, 2].min() + gap
+    lifted = [np.where(t[..., 2:] < floor_z, np.concatenate([t[..., :2], np.full_like(t[..., 2:], floor_z)], axis=-1), t)
+              for t in (obj, moved[rows])]
+    collided = _collisions(*lifted, others, other_ids, 1e-6 * max(scene_size, 1e-9))
     if collided:
         raise DimredError(
             f"at the new place '{name}' would cut through {', '.join(repr(scene.object_names[k]) for k in collided)}"
@@ -105,17 +112,15 @@ def place(scene: SceneData, target: int, move: Move) -> Placement:
 
 
 def _collisions(before: np.ndarray, after: np.ndarray, others: np.ndarray, other_ids: np.ndarray,
-                support: np.ndarray, eps: float) -> list[int]:
-    """Objects (not the support) that the moved object cuts (its edges cross them) or sits in
-    (its centre inside their closed mesh), where its old place did not (a model that already
-    touched a wall a little is not refused for that)."""
+                eps: float) -> list[int]:
+    """Objects that the moved object cuts (its edges cross them) or sits in (its centre inside
+    their closed mesh), where its old place did not (a model that already touched a wall a
+    little is not refused for that)."""
     found = []
     # Not straight up: a box's centre lies under the diagonal its top face's two triangles
     # share, and a ray along that edge would count the face twice.
     up = np.array([[0.0123, 0.0271, 1.0]])
     for k in np.unique(other_ids):
-        if k in support:
-            continue
         tris = others[other_ids == k]
         occ = Occluders(tris, other_ids[other_ids == k], eps)
         # Inside and outside mean something for a closed mesh only (a ceiling with lamp holes

@@ -223,7 +223,7 @@ def test_the_interactive_tool_refuses_to_confirm_a_place_the_engine_would_refuse
     placement = relocate.Placement.of_target(bpy.context)
     tool = SimpleNamespace(_tool=RelocateInput.starting_at(0.0, 2.0), _placement=placement, _saved=before)
     relocate.DIMRED_OT_relocate._show(tool, bpy.context)
-    assert "would not stand on 'Floor'" in tool._tool.refusal
+    assert "would not stand on its support plane" in tool._tool.refusal
     enter = SimpleNamespace(type="RET", value="PRESS", mouse_x=0, mouse_y=0, shift=False, ctrl=False)
     assert tool._tool.handle(enter) == "NONE"
     tool._tool = RelocateInput.starting_at(*MOVE)

@@ -78,7 +78,7 @@ def _with_cabinet(scene):
 
 @pytest.mark.parametrize("case, move, expected", [
     ("floating", Move(10.0, 1.0), "'Box' does not stand on a surface"),
-    ("through the wall", Move(0.0, 1.8), "would not stand on 'Floor'"),
+    ("through the wall", Move(0.0, 1.8), "would not stand on its support plane"),
     ("into another object", Move(90.0, 1.0), "would cut through 'Cabinet'"),
     ("no distance", Move(30.0, 0.0), "positive number"),
 ])
@@ -118,3 +118,21 @@ def test_a_new_place_hidden_from_the_probe_still_casts_its_shadow(tiny):
     assert result.report["relocation"]["object_pixels"] == 0
     assert any("hidden from the probe" in w for w in result.report["warnings"])
     assert np.isfinite(result.difference).all()
+
+
+def test_the_support_is_a_plane_not_an_object(tiny):
+    """A floor modelled in pieces or a rug lying on it holds the object as well at the same height."""
+    half = -1.0  # the floor's x < half becomes an object of its own, with a rug on it
+    floor = tiny.object_names.index("Floor")
+    quad = lambda x0, x1, y0, y1, z: np.array([[[x0, y0, z], [x1, y0, z], [x1, y1, z]], [[x0, y0, z], [x1, y1, z], [x0, y1, z]]])
+    keep = tiny.tri_object != floor
+    lo, hi = tiny_scene.ROOM[0], tiny_scene.ROOM[1]
+    parts = [quad(half, hi[0], lo[1], hi[1], 0.0), quad(lo[0], half, lo[1], hi[1], 0.0),
+             quad(-1.6, -0.4, -0.6, 0.6, 0.002)]
+    names = [*tiny.object_names, "FloorWest", "Rug"]
+    ids = [floor, len(tiny.object_names), len(tiny.object_names) + 1]
+    scene = replace(tiny, triangles=np.concatenate([tiny.triangles[keep], *parts]),
+                    tri_object=np.concatenate([tiny.tri_object[keep], *[np.full(2, k) for k in ids]]),
+                    object_names=names)
+    placement = place(scene, scene.object_names.index("Box"), Move(180.0, 1.0))
+    assert set(placement.support) <= {"Floor", "FloorWest", "Rug"} and "Floor" not in placement.support

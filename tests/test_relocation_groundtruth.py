@@ -63,8 +63,8 @@ def test_relocation_matches_the_render_at_the_new_place(name, yaw, scale, tmp_pa
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name, yaw, scale, expected", [
-    ("red_box", -40.0, 1.3, "would not stand on 'Floor'"),
-    ("second_object", 40.0, 1.3, "would not stand on 'Floor'"),
+    ("red_box", -40.0, 1.3, "would not stand on its support plane"),
+    ("second_object", 40.0, 1.3, "would cut through 'Cabinet'"),
     ("zenith", 30.0, 1.0, "does not stand on a surface"),
     ("basic_box", 40.0, 0.0, "distance factor must be a positive number"),
 ])
