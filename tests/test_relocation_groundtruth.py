@@ -101,3 +101,23 @@ def test_an_object_moved_out_of_a_shadow_is_lit_at_its_new_place(tmp_path):
     assert ratio <= BOUND
     assert y_photo < 0.85 * y_truth
     assert abs(y_edit / y_truth - 1.0) <= 0.1
+
+
+@pytest.mark.slow
+def test_a_red_box_moved_colours_the_floor_at_its_new_place(tmp_path):
+    """The light the object reflects goes with it: around the red box's new place the floor's
+    colour must match the render's (the room without the box lacks that red tint)."""
+    spec = S.get("red_box")
+    yaw, scale = 25.0, 0.8
+    inp, empty, old_mask = load_pair(spec)
+    truth, _, new_mask = load_pair(S.relocated(spec, yaw, scale))
+    proc = _relocate(tmp_path, render_pair(spec)["blend"], spec.remove, "--yaw", str(yaw), "--distance-scale", str(scale))
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    edit = read_exr(tmp_path / "out" / "edited.exr")
+    both = old_mask | new_mask
+    around = M.dilate(new_mask, 12) & ~M.dilate(both, 2)
+    without_box, _ = M.bleeding_error(empty, edit, truth, both, around)
+    photographed, moved = M.bleeding_error(inp, edit, truth, both, around)
+    print(f"red_box: colour error around the new place: room without the box {without_box:.4f}, "
+          f"photograph {photographed:.4f}, relocated {moved:.4f}")
+    assert moved <= 0.3 * without_box and moved <= 0.5 * photographed
