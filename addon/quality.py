@@ -55,3 +55,14 @@ def params_for(quality: str, **overrides) -> Params:
         return replace(PRESETS[quality], **overrides)
     except TypeError as exc:
         raise DimredError(f"unknown parameter: {exc}") from None
+
+
+# The solver's accuracy knobs (not the synthesis's, not the relocation's passes).
+_SOLVER_FIELDS = ("patches", "object_patches", "sender_fraction", "max_senders", "sender_samples", "fine_cells",
+                  "fine_pixels", "reach", "significance", "patch_samples", "max_bounces", "bounce_tolerance")
+
+
+def rough(params: Params) -> Params:
+    """`params` with the solver's accuracy of the draft preset: for a solve whose result only
+    feeds a later, full one."""
+    return replace(params, **{name: getattr(PRESETS["draft"], name) for name in _SOLVER_FIELDS})
