@@ -282,7 +282,6 @@ def relocate(
     current = without.copy()
     moved_scene = replace(scene, triangles=placement.triangles)
     insertion = Report()
-    residuals = []
     carried: list[_Carried] = []
 
     def first_guess(job) -> None:
@@ -317,9 +316,6 @@ def relocate(
             obj = carried[0]
             if len(obj.pix):
                 updated[obj.pix] = obj.rho * new.irradiance(obj.tri, obj.bary) / np.pi
-            y_new, y_without = updated @ LUMA, without @ LUMA
-            # The share of the insertion's change that this pass still changed: how far from its fixed point.
-            residuals.append(float(np.abs(y_new - current @ LUMA).sum() / max(float(np.abs(y_new - y_without).sum()), 1e-30)))
             current = updated
         if preview is not None:
             preview((current.reshape(photo.shape) - photo).astype(np.float32))
@@ -339,7 +335,7 @@ def relocate(
     report["relocation"] = dict(
         yaw=move.yaw, distance_scale=move.distance_scale, elevation_change=round(placement.elevation_change, 3),
         matrix=placement.matrix.tolist(), support=placement.support, object_pixels=int(len(carried[0].pix)),
-        insertion_passes=passes, residuals=[round(r, 5) for r in residuals],
+        insertion_passes=passes,
     )
     if abs(placement.elevation_change) > 10.0:
         report["warnings"].append(

@@ -37,7 +37,6 @@ def test_moving_nowhere_gives_back_the_photograph(tiny):
     y_back, y_removal = np.abs(back.difference) @ LUMA, np.abs(removal.difference) @ LUMA
     assert y_back.sum() <= 0.15 * y_removal.sum()
     assert back.report["relocation"]["elevation_change"] == 0.0
-    assert back.report["relocation"]["residuals"][-1] < 0.2
 
 
 def test_the_object_shows_at_its_new_place(tiny):
