@@ -49,7 +49,7 @@ class DIMRED_OT_mark_remove(bpy.types.Operator):
 
     def execute(self, context: bpy.types.Context) -> set[str]:
         settings = context.scene.dimred
-        settings.target = context.active_object
+        settings.mark(context.active_object)
         # The object to remove cannot also be a surface to edit.
         for index in reversed(range(len(settings.surfaces))):
             if settings.surfaces[index].object == settings.target:

@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING
 
 import bpy
 import numpy as np
-from bpy.props import FloatProperty
+from bpy.props import BoolProperty, FloatProperty
 from mathutils import Matrix
 
 from ..addon.errors import DimredError
@@ -86,6 +86,31 @@ class Placement:
         return elevation_change(self.center, self.reference, move)
 
 
+def transform_move(context: bpy.types.Context) -> "tuple[Move, Matrix]":
+    """The move the artist made by hand: from the marked object's photographed matrix (its
+    relocation's, else where it stood when marked) to where it stands now, and that matrix;
+    DimredError for a move the fixed-view constraint forbids (a tilt, a lift, a scale, a turn
+    that is not the orbit)."""
+    from ..addon import bridge
+    from ..addon.fixedview import move_between, reference_point
+
+    scene, settings = context.scene, context.scene.dimred
+    obj = settings.target
+    bridge.check_object(scene, obj.name, purpose="relocated")
+    index = next((i for i, r in enumerate(settings.removals) if r.object_name == obj.name and r.kind == 'RELOCATE'), -1)
+    photographed = settings.removals[index].photographed_matrix() if index >= 0 else settings.marked_placement()
+    if photographed is None:
+        raise DimredError(f"'{obj.name}' has no recorded photographed place: mark it (Mark Object to Remove) "
+                          "where the photograph shows it, then move it")
+    if obj.matrix_world == photographed:
+        raise DimredError(f"'{obj.name}' stands where the panorama shows it: move it with G and R first, or give "
+                          "a yaw and a distance factor")
+    data = S.engine_scene(scene, obj.name, photographed)
+    reference = reference_point(data.triangles[data.tri_object == data.object_index(obj.name)])
+    move = move_between(data.center, reference, np.array(photographed), np.array(obj.matrix_world))
+    return move, photographed
+
+
 def snapshot(obj: bpy.types.Object) -> dict[str, tuple[float, ...]]:
     """The transform channels that setting matrix_world rewrites, for `restore`."""
     return {name: tuple(getattr(obj, name)) for name in _TRANSFORM_CHANNELS}
@@ -121,11 +146,34 @@ class DIMRED_OT_relocate(RunOperator, bpy.types.Operator):
     _placement: Placement | None = None
     _saved: dict | None = None  # the object's transform channels before the tool moved it
 
-    def move(self) -> "Move":
-        return _move(self.yaw, self.distance_scale)
+    from_transform: BoolProperty(
+        name="From Transform",
+        description=(
+            "Take the move from where the object stands now, moved with G and R in the viewport, measured from "
+            "where it stood when it was marked (or from its photographed place once relocated). Refused unless "
+            "it turns the object about the probe centre's vertical axis by the angle it goes round it, and keeps "
+            "its height and size"
+        ),
+        options={'SKIP_SAVE'},
+    )
+
+    @classmethod
+    def description(cls, context: bpy.types.Context, properties: bpy.types.OperatorProperties) -> str:
+        if properties.from_transform:
+            return ("Relocate the marked object to where it stands now: move it with G and R in the viewport first "
+                    "(turning it about the probe centre's vertical axis by the angle it goes round it, at its "
+                    "height), then compute the panorama for that place")
+        return cls.bl_description
+
+    def plan(self, context: bpy.types.Context) -> "tuple[Move, Matrix | None]":
+        if not self.from_transform:
+            return _move(self.yaw, self.distance_scale), None
+        move, photographed = transform_move(context)
+        self.yaw, self.distance_scale = move.yaw, move.distance_scale
+        return move, photographed
 
     def invoke(self, context: bpy.types.Context, event: bpy.types.Event) -> set[str]:
-        given = any(self.properties.is_property_set(name) for name in ("yaw", "distance_scale"))
+        given = self.from_transform or any(self.properties.is_property_set(name) for name in ("yaw", "distance_scale"))
         if given or bpy.app.background or context.window is None:
             return super().invoke(context, event)
         try:

@@ -19,6 +19,8 @@ from . import session as S
 from . import world_layer
 
 if TYPE_CHECKING:  # the engine is imported only when a run starts
+    from mathutils import Matrix
+
     from ..addon.fixedview import Move
 
 # Seconds between the modal operator's polls of the worker: fast enough that Esc acts at once
@@ -37,7 +39,7 @@ class RunOperator:
     """What Remove and Relocate share: a run of `session.RemovalSession`, synchronous from
     `execute` and threaded from `invoke` (a modal operator polling it on a timer, Esc cancels).
 
-    Subclasses say what to run with `move` (None: remove)."""
+    Subclasses say what to run with `plan` (no move: remove)."""
 
     _timer = None
     _session: S.RemovalSession | None = None
@@ -54,12 +56,14 @@ class RunOperator:
             return False
         return True
 
-    def move(self) -> "Move | None":
-        return None
+    def plan(self, context: bpy.types.Context) -> "tuple[Move | None, Matrix | None]":
+        """The move to run (None: remove) and the object's photographed matrix (None: the
+        session's default); DimredError when the request is refused."""
+        return None, None
 
     def execute(self, context: bpy.types.Context) -> set[str]:
         try:
-            run = S.RemovalSession.begin(context, self.move())
+            run = S.RemovalSession.begin(context, *self.plan(context))
         except DimredError as error:
             self.report({'ERROR'}, str(error))
             return {'CANCELLED'}
@@ -77,7 +81,7 @@ class RunOperator:
         """Begin the session in a worker thread and poll it on a timer; False (reported) when
         the input is refused."""
         try:
-            self._session = S.RemovalSession.begin(context, self.move())
+            self._session = S.RemovalSession.begin(context, *self.plan(context))
         except DimredError as error:
             self.report({'ERROR'}, str(error))
             return False

@@ -90,17 +90,20 @@ def _earlier(settings: bpy.types.PropertyGroup, target: str) -> list:
     return [r for r in settings.removals if r.object_name != target and r.image is not None]
 
 
-def engine_scene(scene: bpy.types.Scene, target: str) -> "SceneData":
+def engine_scene(scene: bpy.types.Scene, target: str, photographed: Matrix | None = None) -> "SceneData":
     """The scene as the engine must see it for a run on `target`: earlier removed objects gone
     from the room, relocated ones at their new place, and `target` where the panorama shows it
-    (also when an earlier relocation of it has moved it since); the panorama's pixels deferred."""
+    (`photographed`, by default `photographed_matrix`: also when an earlier relocation of it
+    has moved it since); the panorama's pixels deferred."""
     from ..addon import bridge
 
     settings = scene.dimred
     removed = [r.object_name for r in _earlier(settings, target) if r.kind == 'REMOVE']
     scene_data = bridge.read_scene(scene, probe_center(settings), defer_file=True, exclude=removed)
     obj = scene.objects[target]
-    return _placed(scene_data, target, to_photographed(obj, photographed_matrix(settings, obj)))
+    if photographed is None:
+        photographed = photographed_matrix(settings, obj)
+    return _placed(scene_data, target, to_photographed(obj, photographed))
 
 
 def active() -> "RemovalSession | None":
@@ -155,10 +158,13 @@ class RemovalSession:
 
     # -- main thread: gather ------------------------------------------------------------
     @classmethod
-    def begin(cls, context: bpy.types.Context, move: "Move | None" = None) -> "RemovalSession":
+    def begin(cls, context: bpy.types.Context, move: "Move | None" = None,
+              photographed: Matrix | None = None) -> "RemovalSession":
         """Check the input and read the scene; DimredError says what is wrong (nothing changed).
 
-        With `move`, the run relocates the marked object instead of removing it."""
+        With `move`, the run relocates the marked object instead of removing it, from
+        `photographed` (its world matrix where the panorama shows it; by default
+        `photographed_matrix`)."""
         from ..addon import bridge
         from ..addon.fixedview import check_move
         from ..addon.removal_job import RemovalRequest
@@ -185,8 +191,9 @@ class RemovalSession:
             for name in names:
                 bridge.check_object(scene, name, purpose="used as a target surface")
             earlier = _earlier(settings, target)
-            scene_data = engine_scene(scene, target)
-            photographed = photographed_matrix(settings, scene.objects[target])
+            if photographed is None:
+                photographed = photographed_matrix(settings, scene.objects[target])
+            scene_data = engine_scene(scene, target, photographed)
             # Its shape is checked against the panorama's in the worker, where the panorama is read.
             base = _sum_images([r.image for r in earlier])
             request = RemovalRequest(

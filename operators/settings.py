@@ -56,6 +56,18 @@ DISTANCE_DESCRIPTION = ("Factor on the object's horizontal distance from the pro
                         "it); the object stays on its support plane")
 
 
+def _matrix(values) -> Matrix:
+    return Matrix([values[row * 4:row * 4 + 4] for row in range(4)])
+
+
+def _flat(matrix: Matrix) -> list[float]:
+    return [value for row in matrix for value in row]
+
+
+def _matrix_property(name: str, description: str) -> FloatVectorProperty:
+    return FloatVectorProperty(name=name, description=description, size=16, options={'HIDDEN'})
+
+
 class DimredRemoval(bpy.types.PropertyGroup):
     """One object removed from the panorama or relocated in it, in order, with its own
     difference image.
@@ -75,18 +87,14 @@ class DimredRemoval(bpy.types.PropertyGroup):
     )
     yaw: _yaw_property(YAW_DESCRIPTION)
     distance_scale: _distance_property(DISTANCE_DESCRIPTION)
-    photographed: FloatVectorProperty(
-        name="Photographed Matrix",
-        description="The object's world matrix where the panorama shows it, row by row",
-        size=16,
-        options={'HIDDEN'},
-    )
+    photographed: _matrix_property("Photographed Matrix",
+                                   "The object's world matrix where the panorama shows it, row by row")
 
     def photographed_matrix(self) -> Matrix:
-        return Matrix([self.photographed[row * 4:row * 4 + 4] for row in range(4)])
+        return _matrix(self.photographed)
 
     def set_photographed_matrix(self, matrix: Matrix) -> None:
-        self.photographed = [value for row in matrix for value in row]
+        self.photographed = _flat(matrix)
 
 
 class DimredSettings(bpy.types.PropertyGroup):
@@ -112,6 +120,10 @@ class DimredSettings(bpy.types.PropertyGroup):
         type=bpy.types.Object,
         poll=_is_mesh,
     )
+    # Where the marked object stood when it was marked (the proxy aligned with the photograph):
+    # Relocate "from transform" measures the artist's G/R move from there.
+    marked_name: StringProperty(options={'HIDDEN'})
+    marked_matrix: _matrix_property("Marked Matrix", "The marked object's world matrix when it was marked, row by row")
     surfaces: CollectionProperty(
         name="Surfaces",
         description="Surfaces to edit; when empty, the surfaces the removal reveals or relights are found automatically",
@@ -189,6 +201,18 @@ class DimredSettings(bpy.types.PropertyGroup):
         if not self.override_parameters:
             return {}
         return {name: getattr(self, name) for name in OVERRIDABLE}
+
+    def mark(self, obj: bpy.types.Object) -> None:
+        """Make `obj` the target and remember where it stands now."""
+        self.target = obj
+        self.marked_name = obj.name
+        self.marked_matrix = _flat(obj.matrix_world)
+
+    def marked_placement(self) -> Matrix | None:
+        """The target's world matrix when it was marked, if it was marked under its present name."""
+        if self.target is None or self.marked_name != self.target.name:
+            return None
+        return _matrix(self.marked_matrix)
 
     def surface_names(self) -> tuple[str, ...]:
         """Names of the marked surfaces that still exist."""

@@ -65,6 +65,7 @@ class DIMRED_PT_main(bpy.types.Panel):
             row.prop(settings, "distance_scale", text="Distance ×")
             apply = row.operator("dimred.relocate", text="", icon='CHECKMARK')
             apply.yaw, apply.distance_scale = settings.yaw, settings.distance_scale
+            row.operator("dimred.relocate", text="", icon='OBJECT_ORIGIN').from_transform = True
         else:
             row = column.row(align=True)
             row.progress(factor=running.fraction, type='BAR',
