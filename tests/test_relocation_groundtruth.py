@@ -13,6 +13,7 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+from dataclasses import dataclass
 
 import numpy as np
 import pytest
@@ -37,25 +38,42 @@ def _relocate(tmp_path, blend, name: str, *arguments: str) -> subprocess.Complet
     )
 
 
-@pytest.mark.slow
-@pytest.mark.parametrize("name, yaw, scale", CASES)
-def test_relocation_matches_the_render_at_the_new_place(name, yaw, scale, tmp_path):
-    spec = S.get(name)
+@dataclass
+class Relocated:
+    """The renders with the object at its old place (`input`), without it (`empty`) and at the
+    new place (`truth`), the two object masks, and the command line's edit and report."""
+
+    input: np.ndarray
+    empty: np.ndarray
+    truth: np.ndarray
+    old_mask: np.ndarray
+    new_mask: np.ndarray
+    edit: np.ndarray
+    report: dict
+
+
+def _relocated(spec: S.SceneSpec, yaw: float, scale: float, tmp_path) -> Relocated:
+    """Relocate through the command line as a user does; every output pixel finite."""
     inp, empty, old_mask = load_pair(spec)
     truth, _, new_mask = load_pair(S.relocated(spec, yaw, scale))
     proc = _relocate(tmp_path, render_pair(spec)["blend"], spec.remove, "--yaw", str(yaw), "--distance-scale", str(scale))
     assert proc.returncode == 0, proc.stderr[-2000:]
     out = tmp_path / "out"
     edit, diff = read_exr(out / "edited.exr"), read_exr(out / "difference.exr")
-    report = json.loads((out / "report.json").read_text())
     assert np.isfinite(edit).all() and np.isfinite(diff).all()
-    region = M.relocation_region(inp, truth, empty, old_mask, new_mask)
-    ratio = M.relocation_error_ratio(inp, edit, truth, region)
-    far = M.far_damage(inp, edit, truth, old_mask | new_mask, region=region)
-    rel = report["relocation"]
+    return Relocated(inp, empty, truth, old_mask, new_mask, edit, json.loads((out / "report.json").read_text()))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name, yaw, scale", CASES)
+def test_relocation_matches_the_render_at_the_new_place(name, yaw, scale, tmp_path):
+    r = _relocated(S.get(name), yaw, scale, tmp_path)
+    region = M.relocation_region(r.input, r.truth, r.empty, r.old_mask, r.new_mask)
+    ratio = M.relocation_error_ratio(r.input, r.edit, r.truth, region)
+    far = M.far_damage(r.input, r.edit, r.truth, r.old_mask | r.new_mask, region=region)
+    rel = r.report["relocation"]
     print(f"{name} yaw {yaw} x{scale}: error {ratio:.3f} of the input's over {int(region.sum())} px, far damage "
-          f"{far:.3f}, elevation {rel['elevation_change']:+.1f} deg, "
-          f"{report['seconds']['total']:.1f} s")
+          f"{far:.3f}, elevation {rel['elevation_change']:+.1f} deg, {r.report['seconds']['total']:.1f} s")
     assert ratio <= BOUND
     assert far <= FAR_DAMAGE
     assert rel["yaw"] == yaw and rel["distance_scale"] == scale and rel["support"] == ["Floor"]
@@ -85,13 +103,8 @@ def test_an_object_moved_out_of_a_shadow_is_lit_at_its_new_place(tmp_path):
     light its carried appearance must brighten as much as the render says, not keep the shadow.
     The box is lit indirectly there, so the renders take 256 samples (at 64 their noise alone
     is a third of the input's error)."""
-    spec = S.get("shadowed_box").with_render(samples=256)
-    yaw, scale = 40.0, 1.3
-    inp, empty, old_mask = load_pair(spec)
-    truth, _, new_mask = load_pair(S.relocated(spec, yaw, scale))
-    proc = _relocate(tmp_path, render_pair(spec)["blend"], spec.remove, "--yaw", str(yaw), "--distance-scale", str(scale))
-    assert proc.returncode == 0, proc.stderr[-2000:]
-    edit = read_exr(tmp_path / "out" / "edited.exr")
+    r = _relocated(S.get("shadowed_box").with_render(samples=256), 40.0, 1.3, tmp_path)
+    inp, empty, truth, old_mask, new_mask, edit = r.input, r.empty, r.truth, r.old_mask, r.new_mask, r.edit
     region = M.relocation_region(inp, truth, empty, old_mask, new_mask)
     ratio = M.relocation_error_ratio(inp, edit, truth, region)
     core_old, core_new = (m & ~M.dilate(~m, 1) for m in (old_mask, new_mask))
@@ -107,13 +120,8 @@ def test_an_object_moved_out_of_a_shadow_is_lit_at_its_new_place(tmp_path):
 def test_a_red_box_moved_colours_the_floor_at_its_new_place(tmp_path):
     """The light the object reflects goes with it: around the red box's new place the floor's
     colour must match the render's (the room without the box lacks that red tint)."""
-    spec = S.get("red_box")
-    yaw, scale = 25.0, 0.8
-    inp, empty, old_mask = load_pair(spec)
-    truth, _, new_mask = load_pair(S.relocated(spec, yaw, scale))
-    proc = _relocate(tmp_path, render_pair(spec)["blend"], spec.remove, "--yaw", str(yaw), "--distance-scale", str(scale))
-    assert proc.returncode == 0, proc.stderr[-2000:]
-    edit = read_exr(tmp_path / "out" / "edited.exr")
+    r = _relocated(S.get("red_box"), 25.0, 0.8, tmp_path)
+    inp, empty, truth, old_mask, new_mask, edit = r.input, r.empty, r.truth, r.old_mask, r.new_mask, r.edit
     both = old_mask | new_mask
     around = M.dilate(new_mask, 12) & ~M.dilate(both, 2)
     without_box, _ = M.bleeding_error(empty, edit, truth, both, around)
