@@ -268,8 +268,10 @@ def relocate(
     target = scene.object_names.index(object_name)
     if not (np.asarray(scene.tri_object) == target).any():
         raise DimredError(f"'{object_name}' has no faces to move")
-    placement = place(scene, target, move)
     passes = params.insertion_passes
+    if passes < 1:
+        raise DimredError(f"insertion_passes must be at least 1, got {passes}")
+    placement = place(scene, target, move)
     share = 1.0 / (1 + passes)
 
     rep = Report(_scaled(progress, 0.0, share, "removal: "), stages=8)
@@ -283,6 +285,7 @@ def relocate(
     moved_scene = replace(scene, triangles=placement.triangles)
     insertion = Report()
     carried: list[_Carried] = []
+    steps: list[dict] = []
 
     def first_guess(job) -> None:
         # The object's patches send light too: before the first pass reads the panorama as
@@ -317,16 +320,18 @@ def relocate(
             if len(obj.pix):
                 updated[obj.pix] = obj.rho * new.irradiance(obj.tri, obj.bary) / np.pi
             current = updated
+        steps.append(step.as_dict())
         if preview is not None:
             preview((current.reshape(photo.shape) - photo).astype(np.float32))
-    last = step.as_dict()
+    last = steps[-1]
     insertion.guard("insertion_ratio_clamped_pixels", int(wild.sum()))
     difference = (current.reshape(photo.shape) - photo).astype(np.float32)
     hidden = removed.hidden_mask.ravel().copy()
     hidden[carried[0].pix] = True
     done = insertion.as_dict()
     report["seconds"] = {**{f"removal_{k}": v for k, v in report["seconds"].items() if k != "total"},
-                         **{f"insertion_{k}": v for k, v in last["seconds"].items() if k != "total"},
+                         **{f"insertion_{k}": round(sum(st["seconds"].get(k, 0.0) for st in steps), 4)
+                            for k in last["seconds"] if k != "total"},
                          "insertion": done["seconds"].get("insertion", 0.0),
                          "total": round(report["seconds"]["total"] + done["seconds"]["total"], 4)}
     report["warnings"] = list(dict.fromkeys(report["warnings"] + last["warnings"] + done["warnings"]))

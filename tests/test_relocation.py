@@ -135,3 +135,15 @@ def test_the_support_is_a_plane_not_an_object(tiny):
                     object_names=names)
     placement = place(scene, scene.object_names.index("Box"), Move(180.0, 1.0))
     assert set(placement.support) <= {"Floor", "FloorWest", "Rug"} and "Floor" not in placement.support
+
+
+def test_the_number_of_insertion_passes_is_a_parameter(tiny):
+    one = relocate_object(tiny, "Box", Move(-90.0, 1.0), quality="draft", insertion_passes=1)
+    three = relocate_object(tiny, "Box", Move(-90.0, 1.0), quality="draft", insertion_passes=3)
+    assert (one.report["relocation"]["insertion_passes"], three.report["relocation"]["insertion_passes"]) == (1, 3)
+    assert {"removal_local", "insertion_local", "insertion", "total"} <= set(three.report["seconds"])
+    # More passes move the result towards the same fixed point, not elsewhere.
+    change = np.abs(three.difference - one.difference).sum()
+    assert change < 0.5 * np.abs(three.difference).sum()
+    with pytest.raises(DimredError, match="insertion_passes must be at least 1"):
+        relocate_object(tiny, "Box", Move(-90.0, 1.0), quality="draft", insertion_passes=0)
