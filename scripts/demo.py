@@ -1,12 +1,17 @@
-"""The README demo: render the `demo` room, remove its box with the command line, compare.
+"""The README demo: render the `demo` room, remove its box with the command line, compare;
+then move the box elsewhere in the panorama.
 
     .venv/bin/python scripts/demo.py [--width 1024] [--samples N] [--quality balanced]
+                                     [--yaw 40] [--distance-scale 1.3]
 
 Renders (or reuses from .cache/groundtruth) the demo room with and without the box, runs
 `python -m addon.cli remove scene.blend --object Box --out out/demo/removal` exactly as a user
 would, then writes into out/demo/: before.exr, after.exr (the edited panorama), difference.exr,
 truth.exr and side_by_side.png (before / after / truth, top to bottom, tonemapped alike), and
-prints the scores of scenes.metrics.
+prints the scores of scenes.metrics. Then `python -m addon.cli relocate ... --yaw 40
+--distance-scale 1.3 --out out/demo/relocation` moves the box: relocated.exr and
+relocated.png (before / relocated; the relocation's own ground-truth scores are in the tests
+and benchmarks/bench_relocation.py).
 """
 from __future__ import annotations
 
@@ -44,6 +49,8 @@ def main() -> int:
     parser.add_argument("--samples", type=int, default=demo.render.samples,
                         help="Cycles samples per pixel")
     parser.add_argument("--quality", default="balanced", choices=("draft", "balanced", "final"))
+    parser.add_argument("--yaw", type=float, default=40.0, help="the relocation's yaw in degrees")
+    parser.add_argument("--distance-scale", type=float, default=1.3, help="the relocation's distance factor")
     args = parser.parse_args()
     scene = demo.with_render(width=args.width, height=args.width // 2, samples=args.samples)
 
@@ -57,21 +64,14 @@ def main() -> int:
 
     OUT.mkdir(parents=True, exist_ok=True)
     # A failed run must not leave an older run's results looking current.
-    for stale in ("after.exr", "difference.exr", "side_by_side.png"):
+    for stale in ("after.exr", "difference.exr", "side_by_side.png", "relocated.exr", "relocated.png"):
         (OUT / stale).unlink(missing_ok=True)
     shutil.copyfile(paths["input"], OUT / "before.exr")
     shutil.copyfile(paths["truth"], OUT / "truth.exr")
     removal = OUT / "removal"
-    cmd = [sys.executable, "-m", "addon.cli", "remove", str(paths["blend"]),
-           "--object", scene.remove, "--out", str(removal), "--quality", args.quality]
-    print("  $ python " + " ".join(cmd[1:]), flush=True)
-    t = time.perf_counter()
-    proc = subprocess.run(cmd, cwd=REPO, capture_output=True, text=True)
-    seconds = time.perf_counter() - t
-    if proc.returncode != 0:
-        tail = "\n".join((proc.stdout + proc.stderr).strip().splitlines()[-15:])
-        print(f"error: the removal command failed (exit {proc.returncode}) after {seconds:.1f} s; "
-              f"addon.cli may not be complete yet. Its output ends:\n{tail}", file=sys.stderr)
+    seconds = _command(["remove", str(paths["blend"]), "--object", scene.remove, "--out", str(removal),
+                        "--quality", args.quality])
+    if seconds is None:
         return 1
     shutil.copyfile(removal / "edited.exr", OUT / "after.exr")
     shutil.copyfile(removal / "difference.exr", OUT / "difference.exr")
@@ -94,8 +94,40 @@ def main() -> int:
     print(f"  far damage {scores['far_damage']:+.4f} (<= 0: nothing made worse away from the box)")
     print(f"  colour error {scores['bleeding_input']:.4f} before -> "
           f"{scores['bleeding_edit']:.4f} after")
+
+    relocation = OUT / "relocation"
+    seconds = _command(["relocate", str(paths["blend"]), "--object", scene.remove, "--out", str(relocation),
+                        "--quality", args.quality, "--yaw", str(args.yaw), "--distance-scale", str(args.distance_scale)])
+    if seconds is None:
+        return 1
+    shutil.copyfile(relocation / "edited.exr", OUT / "relocated.exr")
+    moved = read_exr(OUT / "relocated.exr")
+    gap = np.full((6, before.shape[1], 3), 255, np.uint8)
+    exposure = auto_exposure(before)
+    write_png(OUT / "relocated.png", np.concatenate([tonemap(before, exposure), gap, tonemap(moved, exposure)]))
+    moved_report = json.loads((relocation / "report.json").read_text())
+    rel = moved_report["relocation"]
+    print(f"  relocation took {seconds:.1f} s: yaw {rel['yaw']:.1f} deg, distance x{rel['distance_scale']:.2f}, "
+          f"view elevation change {rel['elevation_change']:+.1f} deg, standing on {', '.join(rel['support'])}")
+    for warning in moved_report.get("warnings", []):
+        print(f"  warning: {warning}")
     print(f"wrote {', '.join(sorted(p.name for p in OUT.iterdir() if p.is_file()))} in {OUT}")
     return 0
+
+
+def _command(arguments: list[str]) -> float | None:
+    """Run `python -m addon.cli ARGUMENTS` as a user would; its seconds, or None (reported) on failure."""
+    cmd = [sys.executable, "-m", "addon.cli", *arguments]
+    print("  $ python " + " ".join(cmd[1:]), flush=True)
+    t = time.perf_counter()
+    proc = subprocess.run(cmd, cwd=REPO, capture_output=True, text=True)
+    seconds = time.perf_counter() - t
+    if proc.returncode != 0:
+        tail = "\n".join((proc.stdout + proc.stderr).strip().splitlines()[-15:])
+        print(f"error: the {arguments[0]} command failed (exit {proc.returncode}) after {seconds:.1f} s. "
+              f"Its output ends:\n{tail}", file=sys.stderr)
+        return None
+    return seconds
 
 
 if __name__ == "__main__":
