@@ -23,7 +23,7 @@ QUALITY_ITEMS = (
 
 # Settings that override the preset's engine parameter of the same name (addon.quality.Params).
 OVERRIDABLE = ("patches", "max_senders", "max_bounces", "raster_cell", "synth_neighbourhood",
-               "synth_generations", "seed")
+               "synth_generations", "seed", "insertion_passes")
 
 
 def _is_mesh(_settings: bpy.types.PropertyGroup, obj: bpy.types.Object) -> bool:
@@ -172,6 +172,12 @@ class DimredSettings(bpy.types.PropertyGroup):
     seed: IntProperty(
         name="Seed", min=0, default=0,
         description="Random seed of the fill: the same seed gives the same result, another seed another fill",
+    )
+    insertion_passes: IntProperty(
+        name="Insertion Passes", min=1, max=8, default=2,
+        description=("Relocate only: solver passes towards the moved object's new shadow and reflected light. "
+                     "The first already holds the lamps' shadows; more settle the light it reflects, each costing "
+                     "about a removal"),
     )
     yaw: _yaw_property(YAW_DESCRIPTION + ". Where Relocate starts; it keeps the last relocation's value")
     distance_scale: _distance_property(DISTANCE_DESCRIPTION + ". Where Relocate starts; it keeps the last "
