@@ -43,13 +43,13 @@ class Placement:
 
     matrix: np.ndarray  # (4, 4) the move
     triangles: np.ndarray  # (T, 3, 3) the scene's triangles with the object moved
-    support: list[str]  # the objects it stands on
+    support: list[str]  # the objects it stands on at the new place
     elevation_change: float  # degrees, see fixedview.elevation_change
 
 
 def place(scene: SceneData, target: int, move: Move) -> Placement:
     """The object moved by `move`, or a DimredError when the new place breaks the constraint:
-    the object would not stand on the surface it stands on now, would cut through another
+    the object would not stand on its support plane, would cut through or sit inside another
     object or a wall, or would enclose the probe."""
     fixedview.check_move(move)
     rows = scene.tri_object == target
@@ -101,8 +101,9 @@ def place(scene: SceneData, target: int, move: Move) -> Placement:
     # The object's bottom, lifted by the gap, may touch nothing (the support included: a foot
     # inside a cabinet finds the cabinet's bottom below it, but that is no support).
     floor_z = pts[:, 2].min() + gap
-    lifted = [np.where(t[..., 2:] < floor_z, np.concatenate([t[..., :2], np.full_like(t[..., 2:], floor_z)], axis=-1), t)
-              for t in (obj, moved[rows])]
+    lifted = [t.copy() for t in (obj, moved[rows])]
+    for t in lifted:
+        t[..., 2] = np.maximum(t[..., 2], floor_z)
     collided = _collisions(*lifted, others, other_ids, 1e-6 * max(scene_size, 1e-9))
     if collided:
         raise DimredError(
