@@ -49,17 +49,20 @@ class Placement:
     scene: "SceneData"  # the geometry as the engine will see it, for `refusal`
 
     @classmethod
-    def of_target(cls, context: bpy.types.Context) -> "Placement":
-        """The placement of `scene.dimred.target`; DimredError when it cannot be moved."""
+    def of_target(cls, context: bpy.types.Context, photographed: Matrix | None = None) -> "Placement":
+        """The placement of `scene.dimred.target` from `photographed` (by default
+        `session.photographed_matrix`); DimredError when it cannot be moved."""
         from ..addon import bridge
         from ..addon.fixedview import reference_point
 
         scene, settings = context.scene, context.scene.dimred
         obj = settings.target
         bridge.check_object(scene, obj.name, purpose="relocated")
-        data = S.engine_scene(scene, obj.name)
+        if photographed is None:
+            photographed = S.photographed_matrix(settings, obj)
+        data = S.engine_scene(scene, obj.name, photographed)
         reference = reference_point(data.triangles[data.tri_object == data.object_index(obj.name)])
-        return cls(obj.name, S.photographed_matrix(settings, obj), data.center, reference, data)
+        return cls(obj.name, photographed, data.center, reference, data)
 
     def matrix(self, move: "Move") -> Matrix:
         """The object's world matrix after `move`."""
@@ -92,22 +95,22 @@ def transform_move(context: bpy.types.Context) -> "tuple[Move, Matrix]":
     DimredError for a move the fixed-view constraint forbids (a tilt, a lift, a scale, a turn
     that is not the orbit)."""
     from ..addon import bridge
-    from ..addon.fixedview import move_between, reference_point
+    from ..addon.fixedview import move_between
 
-    scene, settings = context.scene, context.scene.dimred
+    settings = context.scene.dimred
     obj = settings.target
-    bridge.check_object(scene, obj.name, purpose="relocated")
-    index = next((i for i, r in enumerate(settings.removals) if r.object_name == obj.name and r.kind == 'RELOCATE'), -1)
-    photographed = settings.removals[index].photographed_matrix() if index >= 0 else settings.marked_placement()
+    bridge.check_object(context.scene, obj.name, purpose="relocated")
+    photographed = S.relocated_matrix(settings, obj.name)
+    if photographed is None:
+        photographed = settings.marked_placement()
     if photographed is None:
         raise DimredError(f"'{obj.name}' has no recorded photographed place: mark it (Mark Object to Remove) "
                           "where the photograph shows it, then move it")
     if obj.matrix_world == photographed:
         raise DimredError(f"'{obj.name}' stands where the panorama shows it: move it with G and R first, or give "
                           "a yaw and a distance factor")
-    data = S.engine_scene(scene, obj.name, photographed)
-    reference = reference_point(data.triangles[data.tri_object == data.object_index(obj.name)])
-    move = move_between(data.center, reference, np.array(photographed), np.array(obj.matrix_world))
+    placement = Placement.of_target(context, photographed)
+    move = move_between(placement.center, placement.reference, np.array(photographed), np.array(obj.matrix_world))
     return move, photographed
 
 

@@ -69,13 +69,17 @@ def probe_center(settings: bpy.types.PropertyGroup) -> tuple[float, float, float
     return tuple(settings.probe_center) if settings.use_probe_center else None
 
 
+def relocated_matrix(settings: bpy.types.PropertyGroup, name: str) -> Matrix | None:
+    """The photographed matrix stored by the relocation of object `name`, if it was relocated."""
+    index = _index(settings, name)
+    entry = settings.removals[index] if index >= 0 else None
+    return entry.photographed_matrix() if entry is not None and entry.kind == 'RELOCATE' else None
+
+
 def photographed_matrix(settings: bpy.types.PropertyGroup, obj: bpy.types.Object) -> Matrix:
     """Where the panorama shows `obj`: the matrix stored by its relocation, else where it is."""
-    index = _index(settings, obj.name)
-    entry = settings.removals[index] if index >= 0 else None
-    if entry is not None and entry.kind == 'RELOCATE':
-        return entry.photographed_matrix()
-    return obj.matrix_world.copy()
+    stored = relocated_matrix(settings, obj.name)
+    return obj.matrix_world.copy() if stored is None else stored
 
 
 def to_photographed(obj: bpy.types.Object, photographed: Matrix) -> np.ndarray | None:
