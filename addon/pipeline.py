@@ -11,7 +11,7 @@ from typing import Callable, Sequence
 import numpy as np
 
 from .errors import DimredError
-from .fixedview import Move, check_move
+from .fixedview import Move
 from .quality import Params, params_for
 from .relocation import relocate
 from .removal import RemovalResult, remove
@@ -86,6 +86,5 @@ def relocate_object(
 ) -> RemovalResult:
     """Move `object_name` under the fixed-view constraint (see `relocation.relocate`): the
     same images and report as a removal, with `report["relocation"]` describing the move."""
-    check_move(move)
     return _run(scene, quality, overrides,
                 lambda s, params: relocate(s, object_name, move, list(planes), params, progress, cancel, preview))

@@ -51,7 +51,6 @@ def place(scene: SceneData, target: int, move: Move) -> Placement:
     """The object moved by `move`, or a DimredError when the new place breaks the constraint:
     the object would not stand on its support plane, would cut through or sit inside another
     object or a wall, or would enclose the probe."""
-    fixedview.check_move(move)
     rows = scene.tri_object == target
     tris = np.asarray(scene.triangles, dtype=np.float64)
     obj = tris[rows]
@@ -141,19 +140,11 @@ def _collisions(before: np.ndarray, after: np.ndarray, others: np.ndarray, other
 
 def _closed(triangles: np.ndarray, eps: float) -> bool:
     """Whether the triangles form closed surfaces: every edge shared by an even number of them."""
-    keys = np.round(triangles / max(eps, 1e-12)).astype(np.int64)
-    a, b = keys.reshape(-1, 3), np.roll(keys, -1, axis=1).reshape(-1, 3)
-    edges = np.where(_less(a, b)[:, None], np.concatenate([a, b], axis=1), np.concatenate([b, a], axis=1))
+    corners = np.round(triangles.reshape(-1, 3) / max(eps, 1e-12)).astype(np.int64)
+    ids = np.unique(corners, axis=0, return_inverse=True)[1].reshape(-1, 3)
+    edges = np.sort(np.stack([ids, np.roll(ids, -1, axis=1)], axis=-1).reshape(-1, 2), axis=1)
     _, counts = np.unique(edges, axis=0, return_counts=True)
     return bool((counts % 2 == 0).all())
-
-
-def _less(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """(N,) whether rows a are lexicographically before rows b."""
-    diff = a != b
-    first = diff.argmax(axis=1)
-    rows = np.arange(len(a))
-    return diff.any(axis=1) & (a[rows, first] < b[rows, first])
 
 
 def _map_rows(old: Geometry, new: Geometry, tri_new: np.ndarray) -> np.ndarray:
