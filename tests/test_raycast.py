@@ -3,14 +3,7 @@ import numpy as np
 import pytest
 
 from addon.raycast import Occluders, trace_panorama
-
-
-def box(lo, hi):
-    lo, hi = np.asarray(lo, float), np.asarray(hi, float)
-    c = np.array([[x, y, z] for z in (lo[2], hi[2]) for y in (lo[1], hi[1]) for x in (lo[0], hi[0])])
-    faces = [(0, 1, 3), (0, 3, 2), (4, 6, 7), (4, 7, 5), (0, 4, 5), (0, 5, 1),
-             (2, 3, 7), (2, 7, 6), (0, 2, 6), (0, 6, 4), (1, 5, 7), (1, 7, 3)]
-    return c[np.array(faces)]
+from tiny_scene import box_triangles as box
 
 
 ROOM = box([-2.0, -2.5, -1.5], [3.0, 1.5, 1.2])
@@ -71,10 +64,7 @@ def test_an_edge_passing_close_to_a_pole_still_covers_the_rows_beside_it(offset)
 def test_first_hits_and_crossings_of_a_unit_cube():
     from addon.raycast import crossings, first_hits
 
-    corners = np.array([[x, y, z] for x in (0.0, 1.0) for y in (0.0, 1.0) for z in (0.0, 1.0)])
-    faces = [(0, 1, 3), (0, 3, 2), (4, 6, 7), (4, 7, 5), (0, 4, 5), (0, 5, 1), (2, 3, 7), (2, 7, 6),
-             (0, 2, 6), (0, 6, 4), (1, 5, 7), (1, 7, 3)]
-    cube = corners[np.array(faces)]
+    cube = box([0.0, 0.0, 0.0], [1.0, 1.0, 1.0])
     origins = np.array([[0.5, 0.5, -1.0], [0.5, 0.5, 0.5], [2.0, 2.0, 0.5]])
     up = np.broadcast_to([0.0, 0.0, 1.0], origins.shape)
     index, t = first_hits(origins, up, cube)

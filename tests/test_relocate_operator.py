@@ -14,7 +14,7 @@ from types import SimpleNamespace
 import bpy
 import numpy as np
 import pytest
-from mathutils import Matrix
+from mathutils import Matrix, Vector
 
 import tiny_scene
 
@@ -233,28 +233,25 @@ def test_the_interactive_tool_refuses_to_confirm_a_place_the_engine_would_refuse
     assert relocate.snapshot(box) == before
 
 
-def _mark_and_move(delta: np.ndarray) -> bpy.types.Object:
+def _mark_and_move(delta: Matrix) -> bpy.types.Object:
     """Mark the box as the user does (active object, Mark), then move it by the world `delta`."""
     box = bpy.data.objects["Box"]
     bpy.context.view_layer.objects.active = box
     assert bpy.ops.dimred.mark_remove() == {'FINISHED'}
-    box.matrix_world = Matrix(delta.tolist()) @ box.matrix_world
+    box.matrix_world = delta @ box.matrix_world
     bpy.context.view_layer.update()
     return box
 
 
-def _about_probe_axis(yaw: float) -> np.ndarray:
-    a = math.radians(yaw)
-    turn = np.eye(4)
-    turn[:2, :2] = [[math.cos(a), -math.sin(a)], [math.sin(a), math.cos(a)]]
-    to, back = np.eye(4), np.eye(4)
-    to[:3, 3], back[:3, 3] = -np.array(tiny_scene.CENTER), tiny_scene.CENTER
-    return back @ turn @ to
+def _about(point, axis: str, degrees: float) -> Matrix:
+    """The rotation by `degrees` about the world `axis` through `point`."""
+    return Matrix.Translation(point) @ Matrix.Rotation(math.radians(degrees), 4, axis) @ Matrix.Translation(
+        -Vector(point))
 
 
 def test_relocate_from_the_transform_the_artist_gave(room, extension):
     """Moved by hand about the probe centre's axis (G/R), then Relocate from Transform."""
-    box = _mark_and_move(_about_probe_axis(-35.0))
+    box = _mark_and_move(_about(tiny_scene.CENTER, 'Z', -35.0))
     marked = bpy.context.scene.dimred.marked_placement()
     assert bpy.ops.dimred.relocate('EXEC_DEFAULT', True, from_transform=True) == {'FINISHED'}
     settings = bpy.context.scene.dimred
@@ -265,29 +262,15 @@ def test_relocate_from_the_transform_the_artist_gave(room, extension):
     assert json.loads(settings.last_report)["relocation"]["yaw"] == pytest.approx(-35.0)
 
 
-def _tilt() -> np.ndarray:
-    a = math.radians(10.0)
-    tilt = np.eye(4)
-    tilt[1:3, 1:3] = [[math.cos(a), -math.sin(a)], [math.sin(a), math.cos(a)]]
-    to, back = np.eye(4), np.eye(4)
-    centre = 0.5 * (np.array(tiny_scene.BOX[0]) + np.array(tiny_scene.BOX[1]))
-    to[:3, 3], back[:3, 3] = -centre, centre
-    return back @ tilt @ to
-
-
-def _lift() -> np.ndarray:
-    lift = np.eye(4)
-    lift[2, 3] = 0.25
-    return lift
-
-
 @pytest.mark.parametrize("case, expected", [
     ("tilt", "tilts the object by 10.0 degrees"),
     ("lift", "lifts the object by +0.250"),
     ("not moved", "stands where the panorama shows it"),
 ])
 def test_relocate_from_a_transform_the_constraint_forbids_changes_nothing(room, tmp_path, case, expected):
-    delta = {"tilt": _tilt(), "lift": _lift(), "not moved": np.eye(4)}[case]
+    box_centre = 0.5 * (Vector(tiny_scene.BOX[0]) + Vector(tiny_scene.BOX[1]))
+    delta = {"tilt": _about(box_centre, 'X', 10.0), "lift": Matrix.Translation((0.0, 0.0, 0.25)),
+             "not moved": Matrix.Identity(4)}[case]
     _mark_and_move(delta)
     before = _state(tmp_path)
     with pytest.raises(RuntimeError, match=expected.replace("+", r"\+")) as refused:

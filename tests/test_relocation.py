@@ -66,13 +66,14 @@ def _floating(scene, lift: float):
 
 def _with_cabinet(scene):
     """A second object standing where a 90-degree turn puts the box."""
-    lo, hi = (-0.3, 0.6, 0.0), (0.3, 1.4, 0.9)
-    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
-    faces = [(0, 1, 3), (0, 3, 2), (4, 6, 7), (4, 7, 5), (0, 4, 5), (0, 5, 1), (2, 3, 7), (2, 7, 6),
-             (0, 2, 6), (0, 6, 4), (1, 5, 7), (1, 7, 3)]
-    tris = np.concatenate([scene.triangles, corners[np.array(faces)]])
-    ids = np.concatenate([scene.tri_object, np.full(len(faces), len(scene.object_names))])
-    return replace(scene, triangles=tris, tri_object=ids, object_names=[*scene.object_names, "Cabinet"])
+    return _with_object(scene, "Cabinet", tiny_scene.box_triangles((-0.3, 0.6, 0.0), (0.3, 1.4, 0.9)))
+
+
+def _with_object(scene, name: str, triangles: np.ndarray):
+    """`scene` with one more object made of `triangles`."""
+    return replace(scene, triangles=np.concatenate([scene.triangles, triangles]),
+                   tri_object=np.concatenate([scene.tri_object, np.full(len(triangles), len(scene.object_names))]),
+                   object_names=[*scene.object_names, name])
 
 
 @pytest.mark.parametrize("case, move, expected", [
@@ -106,13 +107,7 @@ def test_a_proxy_sunk_into_the_floor_or_floating_a_little_still_stands_on_it(tin
 
 def test_a_new_place_hidden_from_the_probe_still_casts_its_shadow(tiny):
     """Behind a tall cabinet the box shows no pixel; the room still gets its new shadow."""
-    lo, hi = (-0.5, -0.5, 0.0), (-0.4, 0.5, 1.6)
-    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
-    faces = [(0, 1, 3), (0, 3, 2), (4, 6, 7), (4, 7, 5), (0, 4, 5), (0, 5, 1), (2, 3, 7), (2, 7, 6),
-             (0, 2, 6), (0, 6, 4), (1, 5, 7), (1, 7, 3)]
-    scene = replace(tiny, triangles=np.concatenate([tiny.triangles, corners[np.array(faces)]]),
-                    tri_object=np.concatenate([tiny.tri_object, np.full(len(faces), len(tiny.object_names))]),
-                    object_names=[*tiny.object_names, "Cabinet"])
+    scene = _with_object(tiny, "Cabinet", tiny_scene.box_triangles((-0.5, -0.5, 0.0), (-0.4, 0.5, 1.6)))
     result = relocate_object(scene, "Box", Move(180.0, 1.0), quality="draft")
     assert result.report["relocation"]["object_pixels"] == 0
     assert any("hidden from the probe" in w for w in result.report["warnings"])

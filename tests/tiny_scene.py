@@ -93,6 +93,15 @@ def _mesh_object(bpy, name: str, vertices: list, faces: list):
     return obj
 
 
+def box_triangles(lo, hi) -> np.ndarray:
+    """(12, 3, 3) triangles of the axis-aligned box from corner `lo` to corner `hi`."""
+    lo, hi = np.asarray(lo, float), np.asarray(hi, float)
+    c = np.array([[x, y, z] for z in (lo[2], hi[2]) for y in (lo[1], hi[1]) for x in (lo[0], hi[0])])
+    faces = [(0, 1, 3), (0, 3, 2), (4, 6, 7), (4, 7, 5), (0, 4, 5), (0, 5, 1),
+             (2, 3, 7), (2, 7, 6), (0, 2, 6), (0, 6, 4), (1, 5, 7), (1, 7, 3)]
+    return c[np.array(faces)]
+
+
 def _box_faces(lo: tuple, hi: tuple) -> tuple[list, list]:
     (x0, y0, z0), (x1, y1, z1) = lo, hi
     vertices = [(x0, y0, z0), (x1, y0, z0), (x1, y1, z0), (x0, y1, z0),
