@@ -16,7 +16,7 @@ _cli_handle = None
 
 def _dimred_command(argv: list[str]) -> int:
     """`blender -c dimred ARGS`: imports the command line only when it is actually used."""
-    from .addon.cli import blender_command
+    from .addon.blender.cli import blender_command
 
     return blender_command(argv)
 

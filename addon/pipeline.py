@@ -11,10 +11,10 @@ from typing import Callable, Sequence
 import numpy as np
 
 from .errors import DimredError
-from .fixedview import Move
+from .relocation.fixedview import Move
 from .quality import Params, params_for
-from .relocation import relocate
-from .removal import RemovalResult, remove
+from .relocation.insertion import relocate
+from .removal.stages import RemovalResult, remove
 from .scene import SceneData
 
 

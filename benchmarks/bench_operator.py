@@ -1,6 +1,6 @@
 """How long Blender's main thread is blocked during a Remove from the UI.
 
-Runs the Remove operator's background session (`operators.session.RemovalSession`) on a rendered
+Runs the Remove operator's background session (`operators.support.session.RemovalSession`) on a rendered
 1024x512 scene the way the modal operator does: gather on the main thread, compute in the
 worker thread, and poll it on a 0.05 s timer. Prints a table: the seconds of the gathering
 step, the longest and mean main-thread time per timer tick, the longest gap between two ticks
@@ -43,7 +43,7 @@ def main() -> None:
 
     extension = _extension()
     extension.register()
-    session_module = sys.modules["diminished_reality.operators.session"]
+    session_module = sys.modules["diminished_reality.operators.support.session"]
     settings = bpy.context.scene.dimred
     settings.target = bpy.data.objects[spec.remove]
     settings.quality = args.quality

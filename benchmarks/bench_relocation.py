@@ -34,8 +34,8 @@ def main() -> None:
 
     import bpy
 
-    from addon import bridge
-    from addon.fixedview import Move
+    from addon.blender import reader as bridge
+    from addon.relocation.fixedview import Move
     from addon.pipeline import relocate_object
 
     inp, empty, old_mask = load_pair(spec)

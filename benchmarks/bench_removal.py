@@ -28,7 +28,7 @@ def main() -> None:
 
     import bpy
 
-    from addon import bridge
+    from addon.blender import reader as bridge
     from addon.pipeline import remove_object
     from scenes.images import read_exr
 

@@ -38,7 +38,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from addon.synthesis import SynthesisParams, fill  # noqa: E402
+from addon.synthesis.texture import SynthesisParams, fill  # noqa: E402
 from textures import TEXTURES, lighting  # noqa: E402
 
 Method = Callable[[np.ndarray, np.ndarray], np.ndarray]  # (image, hole) -> filled image

@@ -58,7 +58,7 @@ def _measure(scene_name: str, width: int, samples: int, settings) -> list[dict]:
     """Rows of one scene: every setting's scores and seconds."""
     import bpy
 
-    from addon import bridge
+    from addon.blender import reader as bridge
     from addon.pipeline import remove_object
     from scenes.images import read_exr
 

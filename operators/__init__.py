@@ -1,10 +1,11 @@
 """The `scene.dimred` settings and the `bpy.ops.dimred.*` operators, registered in order."""
 from __future__ import annotations
 
-from . import marking, relocate, removal, session, settings
+from . import marking, relocate, remove, settings
+from .support import session
 
 # Settings first: the operators and the panel read scene.dimred.
-_modules = (settings, session, marking, removal, relocate)
+_modules = (settings, session, marking, remove, relocate)
 
 
 def register() -> None:

@@ -3,7 +3,7 @@
 The move is a yaw about the vertical axis through the probe centre and a factor on the
 object's horizontal distance from it, both counted from where the panorama shows the object
 (its photographed place, kept by the list of removals once it has been relocated). The run
-itself is Remove's (`removal.RunOperator`): synchronous from scripts and in background mode,
+itself is Remove's (`run_operator.RunOperator`): synchronous from scripts and in background mode,
 threaded with progress when the interactive tool confirms. On success the object stands at its
 new place, so the proxy geometry matches the new panorama and later removals see it there.
 
@@ -23,13 +23,13 @@ from bpy.props import BoolProperty, FloatProperty
 from mathutils import Matrix
 
 from ..addon.errors import DimredError
-from . import session as S
-from .relocate_input import RelocateInput
-from .removal import RunOperator
+from .support import session as S
+from .support.relocate_input import RelocateInput
+from .run_operator import RunOperator
 from .settings import DISTANCE_DESCRIPTION, YAW_DESCRIPTION
 
 if TYPE_CHECKING:  # the engine is imported only when a run starts
-    from ..addon.fixedview import Move
+    from ..addon.relocation.fixedview import Move
     from ..addon.scene import SceneData
 
 # The channels that setting matrix_world rewrites: restored one by one, a cancel leaves the
@@ -52,8 +52,8 @@ class Placement:
     def of_target(cls, context: bpy.types.Context, photographed: Matrix | None = None) -> "Placement":
         """The placement of `scene.dimred.target` from `photographed` (by default
         `session.photographed_matrix`); DimredError when it cannot be moved."""
-        from ..addon import bridge
-        from ..addon.fixedview import reference_point
+        from ..addon.blender import reader as bridge
+        from ..addon.relocation.fixedview import reference_point
 
         scene, settings = context.scene, context.scene.dimred
         obj = settings.target
@@ -66,7 +66,7 @@ class Placement:
 
     def matrix(self, move: "Move") -> Matrix:
         """The object's world matrix after `move`."""
-        from ..addon.fixedview import move_matrix
+        from ..addon.relocation.fixedview import move_matrix
 
         return Matrix(move_matrix(self.center, self.reference, move).tolist()) @ self.photographed
 
@@ -75,7 +75,7 @@ class Placement:
         object), or '': checked as the mouse moves, so the tool never confirms a place the run
         would refuse."""
         from ..addon.errors import DimredError
-        from ..addon.relocation import place
+        from ..addon.relocation.placement import place
 
         try:
             place(self.scene, self.scene.object_index(self.object_name), move)
@@ -84,7 +84,7 @@ class Placement:
         return ""
 
     def elevation_change(self, move: "Move") -> float:
-        from ..addon.fixedview import elevation_change
+        from ..addon.relocation.fixedview import elevation_change
 
         return elevation_change(self.center, self.reference, move)
 
@@ -94,8 +94,8 @@ def transform_move(context: bpy.types.Context) -> "tuple[Move, Matrix]":
     relocation's, else where it stood when marked) to where it stands now, and that matrix;
     DimredError for a move the fixed-view constraint forbids (a tilt, a lift, a scale, a turn
     that is not the orbit)."""
-    from ..addon import bridge
-    from ..addon.fixedview import move_between
+    from ..addon.blender import reader as bridge
+    from ..addon.relocation.fixedview import move_between
 
     settings = context.scene.dimred
     obj = settings.target
@@ -125,7 +125,7 @@ def restore(obj: bpy.types.Object, saved: dict[str, tuple[float, ...]]) -> None:
 
 
 def _move(yaw: float, distance_scale: float) -> "Move":
-    from ..addon.fixedview import Move
+    from ..addon.relocation.fixedview import Move
 
     return Move(yaw=yaw, distance_scale=distance_scale)
 

@@ -5,7 +5,8 @@ import json
 
 import bpy
 
-from ..operators import session, world_layer
+from ..operators.support import session
+from ..operators.support import world_layer
 from ..operators.settings import OVERRIDABLE
 
 CATEGORY = "Diminished Reality"

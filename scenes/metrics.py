@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from addon.latlong import dilate  # noqa: F401  (part of this module's interface)
+from addon.geometry.latlong import dilate  # noqa: F401  (part of this module's interface)
 
 _LUMA = np.array([0.2126, 0.7152, 0.0722])
 

@@ -66,7 +66,7 @@ def render_world(tmp_path: Path):
 
     One sample with a 0.01 px Blackman-Harris filter point-samples each pixel's centre
     direction; the camera rotation (90, 0, -90) degrees makes the render's pixel directions
-    those of `addon.latlong.pixel_directions`. Keep sizes tiny: the machine is shared.
+    those of `addon.geometry.latlong.pixel_directions`. Keep sizes tiny: the machine is shared.
     """
     import tiny_scene
 

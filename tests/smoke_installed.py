@@ -71,7 +71,7 @@ def registered() -> None:
 
 
 def command_function() -> Callable[[list[str]], int]:
-    command = importlib.import_module(f"{PACKAGE}.addon.cli").blender_command
+    command = importlib.import_module(f"{PACKAGE}.addon.blender.cli").blender_command
     assert callable(command)
     return command
 
@@ -118,7 +118,7 @@ def command_run(command: Callable[[list[str]], int], work: Path, hdri_path: Path
 def operator_run(blend: Path, hdri_path: Path) -> None:
     import bpy
 
-    world_layer = importlib.import_module(f"{PACKAGE}.operators.world_layer")
+    world_layer = importlib.import_module(f"{PACKAGE}.operators.support.world_layer")
     bpy.ops.wm.open_mainfile(filepath=str(blend))
     scene = bpy.context.scene
     settings = scene.dimred
@@ -156,7 +156,7 @@ def operator_run(blend: Path, hdri_path: Path) -> None:
 def relocate_run(blend: Path) -> None:
     import bpy
 
-    world_layer = importlib.import_module(f"{PACKAGE}.operators.world_layer")
+    world_layer = importlib.import_module(f"{PACKAGE}.operators.support.world_layer")
     bpy.ops.wm.open_mainfile(filepath=str(blend))
     scene = bpy.context.scene
     scene.dimred.target = box = bpy.data.objects["Box"]

@@ -9,9 +9,10 @@ import bpy
 import numpy as np
 import pytest
 
-from addon import bridge, latlong
+from addon.blender import reader as bridge
+from addon.geometry import latlong
 from addon.errors import DimredError
-from addon.exr import write_exr, write_png
+from addon.io.exr import write_exr, write_png
 
 pytestmark = pytest.mark.usefixtures("fresh_blender")
 

@@ -13,10 +13,12 @@ import bpy
 import numpy as np
 import pytest
 
-from addon import cli, exr, pipeline
+from addon import pipeline
+from addon.blender import cli
+from addon.io import exr
 from addon.errors import DimredError
-from addon.fixedview import Move
-from addon.exr import read_exr, write_exr
+from addon.relocation.fixedview import Move
+from addon.io.exr import read_exr, write_exr
 
 pytestmark = pytest.mark.usefixtures("fresh_blender")
 

@@ -2,9 +2,9 @@
 several triangles has the form factor of their union."""
 import numpy as np
 
-from addon.clusters import cluster_triangles, visibility_samples
-from addon.formfactor import point_to_triangle
-from addon.transport import Parts, form_factors, make_senders
+from addon.geometry.clusters import cluster_triangles, visibility_samples
+from addon.light.formfactor import point_to_triangle
+from addon.light.transport import Parts, form_factors, make_senders
 
 
 def _sphere(n: int = 24) -> np.ndarray:

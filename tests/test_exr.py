@@ -10,7 +10,7 @@ import numpy as np
 import OpenEXR
 import pytest
 
-from addon import exr
+from addon.io import exr
 from addon.errors import DimredError
 
 

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from addon.errors import DimredError
-from addon.fixedview import Move, apply, check_move, elevation_change, move_between, move_matrix, reference_point
+from addon.relocation.fixedview import Move, apply, check_move, elevation_change, move_between, move_matrix, reference_point
 
 CENTER = np.array([0.3, -0.2, 1.5])
 BOX = np.array([[x, y, z] for x in (1.0, 1.6) for y in (0.8, 1.2) for z in (0.0, 0.5)])

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from addon.formfactor import paired_point_to_triangle, point_to_triangle
+from addon.light.formfactor import paired_point_to_triangle, point_to_triangle
 
 UP = np.array([[0.0, 0.0, 1.0]])
 ORIGIN = np.zeros((1, 3))

@@ -1,9 +1,9 @@
 """Filling the floor a lid hides: reflectance synthesised on the plane raster, not blurred."""
 import numpy as np
 
-from addon import hiddenfill as HF
-from addon import latlong
-from addon.synthesis import SynthesisParams
+from addon.synthesis import plane_fill as HF
+from addon.geometry import latlong
+from addon.synthesis.texture import SynthesisParams
 from tests.test_planeraster import maps
 
 WIDTH = 512

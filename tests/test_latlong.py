@@ -2,7 +2,7 @@
 
 The Cycles tests render a world whose Environment Texture holds random texels (Closest
 interpolation) through an equirectangular camera and require every render pixel to equal the
-texel `addon.latlong` picks for that pixel's direction, with and without a Mapping node.
+texel `addon.geometry.latlong` picks for that pixel's direction, with and without a Mapping node.
 """
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ import math
 import numpy as np
 import pytest
 
-from addon import latlong
+from addon.geometry import latlong
 
 TEXTURE_W, TEXTURE_H = 64, 32
 # A render size prime to the texture's: pixel centres fall everywhere inside texels, so a
@@ -84,7 +84,7 @@ def test_sample_nearest_wraps_the_seam_and_clamps_the_poles():
 @pytest.fixture
 def random_texture(tmp_path):
     """A 64 x 32 EXR of random texel colours and its pixels (top row first)."""
-    from addon.exr import write_exr
+    from addon.io.exr import write_exr
 
     pixels = np.random.default_rng(7).random((TEXTURE_H, TEXTURE_W, 3)).astype(np.float32)
     path = tmp_path / "texels.exr"
@@ -146,7 +146,7 @@ MAPPINGS = [
 def test_cycles_renders_the_mapping_rotation_of_the_bridge(random_texture, panorama_world, render_world, kind, degrees, scale):
     import bpy
 
-    from addon import bridge
+    from addon.blender import reader as bridge
 
     path, texels = random_texture
     tree = panorama_world(bpy.data.images.load(str(path)), (kind, tuple(map(math.radians, degrees)), scale))
@@ -159,7 +159,7 @@ def test_mapping_rotation_sign_convention(panorama_world):
     R the right-handed rotation, so world +X shows the texel 40 degrees towards +Y (u = 0.5 - 40/360)."""
     import bpy
 
-    from addon import bridge
+    from addon.blender import reader as bridge
 
     image = bpy.data.images.new("t", 8, 4, float_buffer=True)
     tree = panorama_world(image, ("POINT", (0.0, 0.0, math.radians(40.0)), (1.0, 1.0, 1.0)))

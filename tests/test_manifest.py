@@ -69,8 +69,8 @@ def test_every_platform_has_a_wheel_for_every_blender_python():
 
 def test_zip_holds_the_add_on_and_no_development_files(built_zip):
     names = set(zipfile.ZipFile(built_zip).namelist())
-    for required in ("__init__.py", "blender_manifest.toml", "addon/latlong.py",
-                     "operators/__init__.py", "operators/world_layer.py", "panels/__init__.py"):
+    for required in ("__init__.py", "blender_manifest.toml", "addon/geometry/latlong.py",
+                     "operators/__init__.py", "operators/support/world_layer.py", "panels/__init__.py"):
         assert required in names
     wheels = {Path(w).name for w in build_extension.manifest()["wheels"]}
     assert {Path(n).name for n in names if n.endswith(".whl")} == wheels

@@ -17,7 +17,7 @@ import tiny_scene
 
 
 def test_remove_save_and_clear(room, tmp_path, extension):
-    from diminished_reality.operators import world_layer
+    from diminished_reality.operators.support import world_layer
 
     world = bpy.context.scene.world
     links_before = {(l.from_node.name, l.to_node.name) for l in world.node_tree.links}
@@ -60,7 +60,7 @@ def test_refused_removal_changes_nothing(room, tmp_path):
 # -- the removal as the UI runs it: a worker thread polled by the modal operator's timer ---------
 
 def _session(extension):
-    return importlib.import_module(f"{extension.__name__}.operators.session")
+    return importlib.import_module(f"{extension.__name__}.operators.support.session")
 
 
 def _links(world) -> set:
@@ -69,7 +69,7 @@ def _links(world) -> set:
 
 
 def test_threaded_removal_previews_then_applies(room, tmp_path, extension, drive):
-    from diminished_reality.operators import world_layer
+    from diminished_reality.operators.support import world_layer
 
     S = _session(extension)
     world = bpy.context.scene.world
@@ -90,7 +90,7 @@ def test_threaded_removal_previews_then_applies(room, tmp_path, extension, drive
 
 
 def test_cancel_midway_changes_nothing(room, tmp_path, extension):
-    from diminished_reality.operators import world_layer
+    from diminished_reality.operators.support import world_layer
 
     S = _session(extension)
     assert bpy.ops.dimred.remove() == {'FINISHED'}
@@ -157,7 +157,7 @@ def test_a_second_run_while_one_runs_is_refused(room, extension):
 
 
 def test_undo_after_remove_restores_the_original_world(room, extension):
-    from diminished_reality.operators import world_layer
+    from diminished_reality.operators.support import world_layer
 
     bpy.ops.ed.undo_push(message="before removal")
     # As the UI calls it: a script's operator call pushes an undo step only when asked to.
@@ -172,7 +172,7 @@ def test_undo_after_remove_restores_the_original_world(room, extension):
 
 
 def test_a_second_object_composes_with_the_first(room, tmp_path, extension):
-    from diminished_reality.operators import world_layer
+    from diminished_reality.operators.support import world_layer
 
     settings = bpy.context.scene.dimred
     tiny_scene._mesh_object(bpy, "Crate", *tiny_scene._box_faces((-0.9, -0.8, 0.0), (-0.6, -0.5, 0.3)))
@@ -202,7 +202,7 @@ def test_a_second_object_composes_with_the_first(room, tmp_path, extension):
 
 @pytest.mark.parametrize("storage", ["FILE", "PACK"])
 def test_the_result_survives_saving_and_reopening(room, tmp_path, extension, storage):
-    from diminished_reality.operators import world_layer
+    from diminished_reality.operators.support import world_layer
 
     bpy.context.scene.dimred.storage = storage
     assert bpy.ops.dimred.remove() == {'FINISHED'}

@@ -1,7 +1,7 @@
 """Patch lattices: areas add up, points locate in the right patch, interpolation is exact for linear fields."""
 import numpy as np
 
-from addon.patches import build_lattice, levels_for_count, levels_for_size, split_triangles, triangle_samples
+from addon.geometry.patches import build_lattice, levels_for_count, levels_for_size, split_triangles, triangle_samples
 
 
 def _random_points(tris, tri, rng):

@@ -2,8 +2,8 @@
 import numpy as np
 import pytest
 
-from addon import planeraster as PR
-from addon.raycast import trace_panorama
+from addon.geometry import planeraster as PR
+from addon.geometry.raycast import trace_panorama
 from tests.test_raycast import box
 
 FLOOR_Z = -1.0

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from addon.raycast import Occluders, trace_panorama
+from addon.geometry.raycast import Occluders, trace_panorama
 from tiny_scene import box_triangles as box
 
 
@@ -62,7 +62,7 @@ def test_an_edge_passing_close_to_a_pole_still_covers_the_rows_beside_it(offset)
 
 
 def test_first_hits_and_crossings_of_a_unit_cube():
-    from addon.raycast import crossings, first_hits
+    from addon.geometry.raycast import crossings, first_hits
 
     cube = box([0.0, 0.0, 0.0], [1.0, 1.0, 1.0])
     origins = np.array([[0.5, 0.5, -1.0], [0.5, 0.5, 0.5], [2.0, 2.0, 0.5]])

@@ -50,7 +50,7 @@ def test_registration_leaves_the_engine_unimported():
     )
     assert result.returncode == 0, result.stderr
     # The error type and the worker thread (standard library only) are all the operators need.
-    assert result.stdout.strip().splitlines()[-1] == "['dr.addon.errors', 'dr.addon.worker']"
+    assert result.stdout.strip().splitlines()[-1] == "['dr.addon.errors', 'dr.addon.run', 'dr.addon.run.worker']"
 
 
 def test_operators_and_settings(registered):

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-PATH = Path(__file__).resolve().parent.parent / "operators" / "relocate_input.py"
+PATH = Path(__file__).resolve().parent.parent / "operators" / "support" / "relocate_input.py"
 # Loaded as a file of its own: it must work without the operators package (which imports bpy).
 _spec = importlib.util.spec_from_file_location("relocate_input_standalone", PATH)
 ri = sys.modules[_spec.name] = importlib.util.module_from_spec(_spec)

@@ -42,7 +42,7 @@ def _state(tmp_path: Path) -> dict:
 
 def _expected_matrix(photographed: Matrix, yaw: float, distance_scale: float) -> np.ndarray:
     """Where the move puts the box, from the scene's own numbers (not the engine's report)."""
-    from diminished_reality.addon.fixedview import Move, move_matrix
+    from diminished_reality.addon.relocation.fixedview import Move, move_matrix
 
     lo, hi = np.array(tiny_scene.BOX)
     reference = np.array(photographed) @ np.append(0.5 * (lo + hi), 1.0)
@@ -55,13 +55,13 @@ def _relocate(yaw: float, distance_scale: float) -> set[str]:
 
 
 def _own(settings) -> dict[str, np.ndarray]:
-    from diminished_reality.operators import world_layer
+    from diminished_reality.operators.support import world_layer
 
     return {r.object_name: world_layer.image_rgb(r.image) for r in settings.removals}
 
 
 def _layer() -> np.ndarray:
-    from diminished_reality.operators import world_layer
+    from diminished_reality.operators.support import world_layer
 
     return world_layer.image_rgb(world_layer.layer_image(bpy.context.scene.world))
 
@@ -90,8 +90,8 @@ def test_a_move_into_the_wall_is_refused_by_the_engine_and_changes_nothing(room,
 
 
 def test_relocate_writes_the_layer_moves_the_box_undoes_redoes_and_clears(room, tmp_path, extension):
-    from diminished_reality.addon.fixedview import Move
-    from diminished_reality.operators import world_layer
+    from diminished_reality.addon.relocation.fixedview import Move
+    from diminished_reality.operators.support import world_layer
     from diminished_reality.operators.relocate import Placement
 
     box = bpy.data.objects["Box"]
@@ -133,7 +133,7 @@ def test_relocate_writes_the_layer_moves_the_box_undoes_redoes_and_clears(room, 
 
 
 def test_later_removals_see_the_relocated_object_at_its_new_place(room, extension):
-    S = extension.operators.session
+    S = extension.operators.support.session
     settings = bpy.context.scene.dimred
     tiny_scene._mesh_object(bpy, "Crate", *tiny_scene._box_faces((-0.9, -0.8, 0.0), (-0.6, -0.5, 0.3)))
     box = bpy.data.objects["Box"]
@@ -165,9 +165,9 @@ def test_later_removals_see_the_relocated_object_at_its_new_place(room, extensio
 
 
 def test_relocating_again_starts_from_the_photographed_place_and_replaces_the_entry(room, extension, drive):
-    from diminished_reality.addon.fixedview import Move
+    from diminished_reality.addon.relocation.fixedview import Move
 
-    S = extension.operators.session
+    S = extension.operators.support.session
     settings = bpy.context.scene.dimred
     box = bpy.data.objects["Box"]
     photographed = box.matrix_world.copy()
@@ -190,9 +190,9 @@ def test_relocating_again_starts_from_the_photographed_place_and_replaces_the_en
 
 
 def test_the_interactive_tool_moves_the_box_and_cancel_restores_it_exactly(room, extension):
-    from diminished_reality.addon.fixedview import Move
+    from diminished_reality.addon.relocation.fixedview import Move
     from diminished_reality.operators import relocate
-    from diminished_reality.operators.relocate_input import RelocateInput
+    from diminished_reality.operators.support.relocate_input import RelocateInput
 
     box = bpy.data.objects["Box"]
     box.rotation_mode = 'XYZ'
@@ -216,7 +216,7 @@ def test_the_interactive_tool_refuses_to_confirm_a_place_the_engine_would_refuse
     """Checked as the mouse moves: the header says why, and Enter does nothing until the values
     lead to an allowed place."""
     from diminished_reality.operators import relocate
-    from diminished_reality.operators.relocate_input import RelocateInput
+    from diminished_reality.operators.support.relocate_input import RelocateInput
 
     box = bpy.data.objects["Box"]
     before = relocate.snapshot(box)

@@ -8,12 +8,12 @@ import numpy as np
 import pytest
 
 import tiny_scene
-from addon import latlong
+from addon.geometry import latlong
 from addon.errors import DimredError
-from addon.fixedview import Move
+from addon.relocation.fixedview import Move
 from addon.pipeline import relocate_object, remove_object
-from addon.radiosity import LUMA
-from addon.relocation import place
+from addon.light.radiosity import LUMA
+from addon.relocation.placement import place
 
 
 @pytest.fixture(scope="module")

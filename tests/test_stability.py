@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 import tiny_scene
-from addon.formfactor import point_to_triangle
+from addon.light.formfactor import point_to_triangle
 from addon.pipeline import remove_object
 
 

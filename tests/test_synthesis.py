@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from addon.errors import Cancelled, DimredError
-from addon.synthesis import OrderIndependentSynthesis, SynthesisParams, fill, neighbourhoods, pyramid
+from addon.synthesis.texture import OrderIndependentSynthesis, SynthesisParams, fill, neighbourhoods, pyramid
 
 
 def _stripes(size=96, period=8, seed=0):

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from addon.errors import Cancelled, DimredError
-from addon.worker import Worker
+from addon.run.worker import Worker
 
 
 def _wait(worker: Worker, timeout: float = 10.0):

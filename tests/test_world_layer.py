@@ -11,7 +11,7 @@ from tiny_scene import write_exr
 
 @pytest.fixture
 def world_layer(extension):
-    from diminished_reality.operators import world_layer
+    from diminished_reality.operators.support import world_layer
 
     return world_layer
 

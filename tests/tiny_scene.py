@@ -143,7 +143,7 @@ def render_world(width: int, height: int, origin, path: str | Path) -> np.ndarra
 
     One sample with a 0.01 px Blackman-Harris filter point-samples each pixel's centre
     direction; the camera rotation (90, 0, -90) degrees makes the render's pixel directions
-    those of `addon.latlong.pixel_directions`. Keep sizes tiny: the machine is shared.
+    those of `addon.geometry.latlong.pixel_directions`. Keep sizes tiny: the machine is shared.
     """
     import math
 
@@ -191,7 +191,7 @@ def scene_data(folder: str | Path, width: int, height: int):
     session is emptied again afterwards."""
     import bpy
 
-    from addon import bridge
+    from addon.blender import reader as bridge
 
     bpy.ops.wm.read_factory_settings(use_empty=True)
     hdri = Path(folder) / "room.exr"

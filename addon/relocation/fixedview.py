@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import DimredError
+from ..errors import DimredError
 
 _TOLERANCE_DEG = 0.5  # angles within this count as equal (a user's rotation snapped to 1 degree passes)
 _TOLERANCE_REL = 1e-3  # lengths within this share of the object's distance count as equal

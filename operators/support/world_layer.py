@@ -10,7 +10,7 @@ from __future__ import annotations
 import bpy
 import numpy as np
 
-from ..addon.errors import DimredError
+from ...addon.errors import DimredError
 
 TEXTURE_NAME = "DimRed Difference"
 MIX_NAME = "DimRed Add"

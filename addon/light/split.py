@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .patches import split_triangles
+from ..geometry.patches import split_triangles
 from .transport import Senders, make_senders
 
 

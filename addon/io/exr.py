@@ -19,7 +19,7 @@ from collections.abc import Callable, Iterator
 import numpy as np
 import OpenEXR
 
-from .errors import DimredError
+from ..errors import DimredError
 
 
 def read_exr(path: str | os.PathLike[str]) -> np.ndarray:

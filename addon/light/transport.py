@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .formfactor import point_to_triangle
-from .raycast import Occluders
+from ..geometry.raycast import Occluders
 
 _SEGMENTS_PER_CHUNK = 300_000
 

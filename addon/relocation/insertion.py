@@ -21,130 +21,20 @@ from typing import Callable
 
 import numpy as np
 
-from . import fixedview, latlong
-from .errors import DimredError
+from . import fixedview
+from ..geometry import latlong
+from ..errors import DimredError
 from .fixedview import Move
-from .geometry import Geometry
-from .quality import Params, rough
-from .radiosity import LUMA, RHO_MAX
-from .raycast import Occluders, crossings, first_hits
-from .removal import RemovalResult, Solution, _Removal, finish, solve
-from .report import Report
-from .scene import SceneData
+from .placement import place
+from ..geometry.mesh import Geometry
+from ..quality import Params, rough
+from ..light.radiosity import LUMA, RHO_MAX
+from ..removal.stages import RemovalResult, Solution, _Removal, finish, solve
+from ..report import Report
+from ..scene import SceneData
 
 _RATIO_MAX = 4.0  # an insertion darkens (shadow) or brightens a little (reflected light); beyond this the model failed
-_SUPPORT_GAP = 0.02  # of the object's height: a foot this close above a surface stands on it
 _SEEN_DEPTH = 0.02  # a photographed pixel shows a point of the object if its depth agrees to this share
-
-
-@dataclass
-class Placement:
-    """Where the move puts the object (world space), and what it stands on."""
-
-    matrix: np.ndarray  # (4, 4) the move
-    triangles: np.ndarray  # (T, 3, 3) the scene's triangles with the object moved
-    support: list[str]  # the objects it stands on at the new place
-    elevation_change: float  # degrees, see fixedview.elevation_change
-
-
-def place(scene: SceneData, target: int, move: Move) -> Placement:
-    """The object moved by `move`, or a DimredError when the new place breaks the constraint:
-    the object would not stand on its support plane, would cut through or sit inside another
-    object or a wall, or would enclose the probe."""
-    rows = scene.tri_object == target
-    tris = np.asarray(scene.triangles, dtype=np.float64)
-    obj = tris[rows]
-    name = scene.object_names[target]
-    reference = fixedview.reference_point(obj)
-    matrix = fixedview.move_matrix(scene.center, reference, move)
-    moved = tris.copy()
-    moved[rows] = fixedview.apply(matrix, obj)
-    others = tris[~rows]
-    other_ids = np.asarray(scene.tri_object)[~rows]
-    pts = obj.reshape(-1, 3)
-    size = float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0)))
-    height = float(np.ptp(pts[:, 2]))
-    scene_size = float(np.ptp(tris.reshape(-1, 3), axis=0).max())
-    # A foot stands on a surface within `gap` above or below it: proxies are modelled by hand,
-    # sunk into the floor a little or floating above it.
-    gap = _SUPPORT_GAP * max(height, size * 1e-2)
-
-    feet = np.unique(pts[pts[:, 2] <= pts[:, 2].min() + 1e-2 * max(height, 1e-9)], axis=0)
-    down = np.broadcast_to([0.0, 0.0, -1.0], feet.shape)
-    hit, t = first_hits(feet + [0.0, 0.0, gap], down, others)
-    stands = t <= 2.0 * gap
-    if not stands.any():
-        raise DimredError(
-            f"'{name}' does not stand on a surface (nothing within {gap:.3g} of its lowest points): a "
-            "relocation keeps an object on its support plane, so model the surface it stands on"
-        )
-    new_feet = fixedview.apply(matrix, feet[stands])
-    hit_new, t_new = first_hits(new_feet + [0.0, 0.0, gap], down[: len(new_feet)], others)
-    # The support is a plane, not an object: a floor modelled in pieces, or a rug on it, holds
-    # the object as well at the same height.
-    off = t_new > 2.0 * gap
-    if off.any():
-        was_on = ", ".join(repr(scene.object_names[k]) for k in np.unique(other_ids[hit[stands]]))
-        below = sorted({scene.object_names[other_ids[k]] for k in hit_new[off] if k >= 0})
-        where = f"over {', '.join(repr(n) for n in below)} at another height" if below else "over nothing"
-        raise DimredError(
-            f"at the new place '{name}' would not stand on its support plane (where {was_on} holds it now): "
-            f"{int(off.sum())} of its feet would be {where}. Choose a smaller move"
-        )
-    support = [scene.object_names[k] for k in np.unique(other_ids[hit_new])]
-
-    new_pts = moved[rows].reshape(-1, 3)
-    centre = np.asarray(scene.center, dtype=np.float64)
-    if np.all(new_pts.min(axis=0) < centre) and np.all(new_pts.max(axis=0) > centre):
-        raise DimredError(f"at the new place '{name}' would enclose the probe centre")
-    # The object's bottom, lifted by the gap, may touch nothing (the support included: a foot
-    # inside a cabinet finds the cabinet's bottom below it, but that is no support).
-    floor_z = pts[:, 2].min() + gap
-    lifted = [t.copy() for t in (obj, moved[rows])]
-    for t in lifted:
-        t[..., 2] = np.maximum(t[..., 2], floor_z)
-    collided = _collisions(*lifted, others, other_ids, 1e-6 * max(scene_size, 1e-9))
-    if collided:
-        raise DimredError(
-            f"at the new place '{name}' would cut through {', '.join(repr(scene.object_names[k]) for k in collided)}"
-        )
-    return Placement(matrix, moved, support, fixedview.elevation_change(scene.center, reference, move))
-
-
-def _collisions(before: np.ndarray, after: np.ndarray, others: np.ndarray, other_ids: np.ndarray,
-                eps: float) -> list[int]:
-    """Objects that the moved object cuts (its edges cross them) or sits in (its centre inside
-    their closed mesh), where its old place did not (a model that already touched a wall a
-    little is not refused for that)."""
-    found = []
-    # Not straight up: a box's centre lies under the diagonal its top face's two triangles
-    # share, and a ray along that edge would count the face twice.
-    up = np.array([[0.0123, 0.0271, 1.0]])
-    for k in np.unique(other_ids):
-        tris = others[other_ids == k]
-        occ = Occluders(tris, other_ids[other_ids == k], eps)
-        # Inside and outside mean something for a closed mesh only (a ceiling with lamp holes
-        # is crossed once or not at all, wherever one stands).
-        closed = _closed(tris, eps)
-
-        def collides(obj: np.ndarray) -> bool:
-            a = obj.reshape(-1, 3)
-            b = np.roll(obj, -1, axis=1).reshape(-1, 3)
-            inside = closed and crossings(fixedview.reference_point(obj)[None], up, tris)[0] % 2 == 1
-            return bool(inside or occ.blocked(a, b).any())
-
-        if collides(after) and not collides(before):
-            found.append(int(k))
-    return found
-
-
-def _closed(triangles: np.ndarray, eps: float) -> bool:
-    """Whether the triangles form closed surfaces: every edge shared by an even number of them."""
-    corners = np.round(triangles.reshape(-1, 3) / max(eps, 1e-12)).astype(np.int64)
-    ids = np.unique(corners, axis=0, return_inverse=True)[1].reshape(-1, 3)
-    edges = np.sort(np.stack([ids, np.roll(ids, -1, axis=1)], axis=-1).reshape(-1, 2), axis=1)
-    _, counts = np.unique(edges, axis=0, return_counts=True)
-    return bool((counts % 2 == 0).all())
 
 
 def _map_rows(old: Geometry, new: Geometry, tri_new: np.ndarray) -> np.ndarray:

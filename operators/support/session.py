@@ -28,14 +28,14 @@ import bpy
 import numpy as np
 from mathutils import Matrix
 
-from ..addon.errors import Cancelled, DimredError
-from ..addon.worker import Worker
+from ...addon.errors import Cancelled, DimredError
+from ...addon.run.worker import Worker
 from . import world_layer
 
 if TYPE_CHECKING:  # the engine is imported only when a run starts
-    from ..addon.fixedview import Move
-    from ..addon.removal_job import RemovalOutcome, RemovalRequest
-    from ..addon.scene import SceneData
+    from ...addon.relocation.fixedview import Move
+    from ...addon.run.job import RemovalOutcome, RemovalRequest
+    from ...addon.scene import SceneData
 
 PREVIEW_IMAGE = "DimRed Preview"
 # Seconds a cancelled worker may take to notice; the engine checks far more often than this.
@@ -99,7 +99,7 @@ def engine_scene(scene: bpy.types.Scene, target: str, photographed: Matrix | Non
     from the room, relocated ones at their new place, and `target` where the panorama shows it
     (`photographed`, by default `photographed_matrix`: also when an earlier relocation of it
     has moved it since); the panorama's pixels deferred."""
-    from ..addon import bridge
+    from ...addon.blender import reader as bridge
 
     settings = scene.dimred
     removed = [r.object_name for r in _earlier(settings, target) if r.kind == 'REMOVE']
@@ -169,9 +169,9 @@ class RemovalSession:
         With `move`, the run relocates the marked object instead of removing it, from
         `photographed` (its world matrix where the panorama shows it; by default
         `photographed_matrix`)."""
-        from ..addon import bridge
-        from ..addon.fixedview import check_move
-        from ..addon.removal_job import RemovalRequest
+        from ...addon.blender import reader as bridge
+        from ...addon.relocation.fixedview import check_move
+        from ...addon.run.job import RemovalRequest
 
         if active() is not None:
             raise DimredError("A removal is already running: wait for it or cancel it")
@@ -222,7 +222,7 @@ class RemovalSession:
     # -- computing ------------------------------------------------------------------------
     def run_here(self, context: bpy.types.Context) -> bool:
         """Compute on this thread and apply; True on success (`message` says what happened)."""
-        from ..addon.removal_job import run
+        from ...addon.run.job import run
 
         try:
             outcome = run(self.request)
@@ -232,7 +232,7 @@ class RemovalSession:
 
     def start(self) -> None:
         """Compute in a worker thread; `tick` polls it."""
-        from ..addon.removal_job import run
+        from ...addon.run.job import run
 
         request = self.request
         self.worker = Worker(lambda progress, cancelled, preview: run(request, progress, cancelled, preview)).start()
@@ -394,7 +394,7 @@ def move_summary(relocation: dict) -> str:
 
 def _placed(scene: "SceneData", name: str, transform: np.ndarray | None) -> "SceneData":
     """`scene` with the triangles of object `name` moved by the (4, 4) world `transform`."""
-    from ..addon.fixedview import apply
+    from ...addon.relocation.fixedview import apply
 
     if transform is None:
         return scene

@@ -19,23 +19,23 @@ from typing import Callable
 
 import numpy as np
 
-from . import latlong
-from .clusters import cluster_triangles, visibility_samples
-from .errors import Cancelled, DimredError
-from .formfactor import paired_point_to_triangle
-from .geometry import Geometry, boundary_objects, build_geometry, plane_of_object, surface_keys
-from .hiddenfill import PanoramaMaps, fill_surface
-from .patches import Lattice, build_lattice, levels_for_count, levels_for_size, triangle_samples
-from .planeraster import edge_direction
-from .planner import neighbourhood, shadow_volume
-from .quality import Params
-from .radiosity import LUMA, RHO_MAX, fill_unseen, patch_radiosity, propagate, recover_reflectance
-from .raycast import Occluders, trace_panorama
-from .report import Report
-from .scene import SceneData
-from .split import Split
-from .synthesis import SynthesisParams
-from .transport import Parts, Senders, make_senders, pair_visibility, transport
+from ..geometry import latlong
+from ..geometry.clusters import cluster_triangles, visibility_samples
+from ..errors import Cancelled, DimredError
+from ..light.formfactor import paired_point_to_triangle
+from ..geometry.mesh import Geometry, boundary_objects, build_geometry, plane_of_object, surface_keys
+from ..synthesis.plane_fill import PanoramaMaps, fill_surface
+from ..geometry.patches import Lattice, build_lattice, levels_for_count, levels_for_size, triangle_samples
+from ..geometry.planeraster import edge_direction
+from ..light.planner import neighbourhood, shadow_volume
+from ..quality import Params
+from ..light.radiosity import LUMA, RHO_MAX, fill_unseen, patch_radiosity, propagate, recover_reflectance
+from ..geometry.raycast import Occluders, trace_panorama
+from ..report import Report
+from ..scene import SceneData
+from ..light.split import Split
+from ..synthesis.texture import SynthesisParams
+from ..light.transport import Parts, Senders, make_senders, pair_visibility, transport
 
 _MIN_COS = 0.05  # pixels seen more grazing than this count as if at this angle (area weight)
 _VISIBLE = 0.2  # a patch is measured when pixels cover this share of its area

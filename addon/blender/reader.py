@@ -12,9 +12,9 @@ from collections.abc import Sequence
 import bpy
 import numpy as np
 
-from .errors import DimredError
-from .exr import read_exr
-from .scene import SceneData
+from ..errors import DimredError
+from ..io.exr import read_exr
+from ..scene import SceneData
 
 #: Nodes whose name or label starts with this belong to the add-on (the difference layer).
 OWN_NODE_PREFIX = "DimRed"

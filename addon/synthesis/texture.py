@@ -30,7 +30,7 @@ from typing import Callable
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 
-from .errors import Cancelled, DimredError
+from ..errors import Cancelled, DimredError
 
 _BINOMIAL = (1 / 16, 4 / 16, 6 / 16, 4 / 16, 1 / 16)  # Python floats keep float32 arrays float32
 _EXACT = 2**24 - 1  # float32 holds every integer up to this

@@ -20,11 +20,11 @@ from typing import Callable
 
 import numpy as np
 
-from .errors import Cancelled, DimredError
-from .exr import read_exr, write_exr
-from .fixedview import Move
-from .pipeline import relocate_object, remove_object
-from .scene import SceneData
+from ..errors import Cancelled, DimredError
+from ..io.exr import read_exr, write_exr
+from ..relocation.fixedview import Move
+from ..pipeline import relocate_object, remove_object
+from ..scene import SceneData
 
 
 @dataclass

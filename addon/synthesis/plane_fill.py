@@ -13,9 +13,9 @@ from typing import Callable
 
 import numpy as np
 
-from . import planeraster as PR
-from .errors import Cancelled, DimredError
-from .synthesis import SynthesisParams, fill
+from ..geometry import planeraster as PR
+from ..errors import Cancelled, DimredError
+from .texture import SynthesisParams, fill
 
 _MAX_CELLS = 512 * 512  # bounds the raster (and the exemplar) whatever the panorama size
 _DEPTH_TOLERANCE = 0.02  # relative: a cell is where a ray meets its surface within this

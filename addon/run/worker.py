@@ -11,7 +11,7 @@ import threading
 from dataclasses import dataclass
 from typing import Any, Callable, Generic, TypeVar
 
-from .errors import Cancelled
+from ..errors import Cancelled
 
 T = TypeVar("T")
 ProgressFn = Callable[[str, float], None]

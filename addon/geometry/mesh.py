@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import DimredError
+from ..errors import DimredError
 
 
 @dataclass

@@ -1,0 +1,325 @@
+"""The command line: remove or move an object in a scene's panorama without Blender's interface.
+
+    python -m addon.cli remove SCENE.blend --object NAME --out DIR [options]
+    python -m addon.cli relocate SCENE.blend --object NAME --yaw DEG --distance-scale S --out DIR [options]
+    blender -b SCENE.blend -c dimred remove|relocate ... (the same arguments)
+
+Both run `run_cli`; inside Blender the .blend is already open, so SCENE.blend is optional.
+Bad input gets one line `dimred: error: ...` on stderr, exit code 2, and nothing on disk.
+"""
+from __future__ import annotations
+
+import argparse
+import contextlib
+import ctypes
+import io
+import json
+import os
+import shutil
+import sys
+import tempfile
+import time
+from collections.abc import Callable, Iterator, Sequence
+
+import numpy as np
+
+from ..errors import DimredError
+
+PROG = "dimred"
+QUALITIES = ("draft", "balanced", "final")
+#: Exit status for bad input (the same as argparse's usage errors).
+EXIT_BAD_INPUT = 2
+
+_DESCRIPTION = """\
+Remove a real object from the HDR panorama (light probe) that is the world's Environment
+Texture: its shadow, the light it reflected, and the object itself, filled with texture
+synthesised from the surface around it. Writes into the output folder:
+
+  difference.exr   what to add to the panorama (RGB float32, the panorama's size)
+  edited.exr       the panorama plus the difference
+  report.json      seconds per stage, skipped stages, warnings, guards, error estimates
+  hidden_mask.png  only when the region the object hid could not be filled (white = hidden)
+
+Files are written only when the whole run succeeds."""
+
+_QUALITY_HELP = "accuracy preset: draft = fastest, balanced = default, final = most accurate (see below)"
+
+_EPILOG = """\
+quality presets (--quality):
+  draft      fastest: fewest patches, light senders and bounces; coarse shadows and relighting
+  balanced   the default trade-off between run time and accuracy
+  final      most accurate and slowest: most patches, light senders and bounces
+
+The probe centre (where the panorama was taken) is --center if given, else the scene's
+Diminished Reality setting or custom property probe_center, else an object named
+ProbeCenter, else the world origin.
+
+examples:
+  python -m addon.cli remove room.blend --object Box --out out/
+  blender -b room.blend -c dimred remove --object Box --plane Floor --quality final --out out/
+  python -m addon.cli relocate room.blend --object Box --yaw 40 --distance-scale 1.3 --out out/"""
+
+_RELOCATE_DESCRIPTION = """\
+Move a real object elsewhere in the HDR panorama under the fixed-view constraint: the
+panorama shows it from one side only, so it may only turn about the vertical axis through the
+probe centre (its position and its orientation by the same angle, --yaw) and change its
+horizontal distance from that axis (--distance-scale), standing on the surface it stands on.
+It is removed at the old place (shadow, reflected light, the floor behind it synthesised) and
+inserted at the new one (its appearance from the panorama relit there, hiding what is behind
+it, its new shadow and reflected light). A move off its support surface, through a wall or
+another object, or with a distance factor <= 0 is refused. Writes the same files as remove:
+
+  difference.exr   what to add to the panorama (RGB float32, the panorama's size)
+  edited.exr       the panorama plus the difference
+  report.json      as for remove, plus "relocation": the move, its world matrix, the
+                   change of view elevation (degrees) and the insertion's convergence"""
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of `python -m addon.cli`: the .blend is a required argument."""
+    return run_cli(sys.argv[1:] if argv is None else argv, blend_already_loaded=False)
+
+
+def blender_command(argv: Sequence[str]) -> int:
+    """Entry point of `blender -b SCENE.blend -c dimred ...` (bpy.utils.register_cli_command
+    passes the arguments after the command id)."""
+    return run_cli(argv, blend_already_loaded=True)
+
+
+def run_cli(argv: Sequence[str], blend_already_loaded: bool) -> int:
+    """Parse `argv` and run the subcommand; returns the exit status."""
+    parser = build_parser(blend_already_loaded)
+    try:
+        args = parser.parse_args(list(argv))
+    except SystemExit as stop:
+        # argparse exits after --help or a usage error; both callers want a status returned.
+        return stop.code if isinstance(stop.code, int) else EXIT_BAD_INPUT
+    try:
+        return args.run(args)
+    except DimredError as error:
+        # The contract is one line, whatever the message holds.
+        print(f"{PROG}: error: {' '.join(str(error).split())}", file=sys.stderr, flush=True)
+        return EXIT_BAD_INPUT
+
+
+def build_parser(blend_already_loaded: bool) -> argparse.ArgumentParser:
+    """The argument parser; inside Blender SCENE.blend is optional (the open file is used)."""
+    parser = argparse.ArgumentParser(
+        prog="blender -b SCENE.blend -c dimred" if blend_already_loaded else "python -m addon.cli",
+        description=_DESCRIPTION,
+        epilog=_EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    commands = parser.add_subparsers(title="commands", dest="command", required=True, metavar="COMMAND")
+    remove = commands.add_parser(
+        "remove",
+        help="remove an object from the panorama",
+        description=_DESCRIPTION,
+        epilog=_EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    _scene_arguments(remove, blend_already_loaded, "the mesh object to remove")
+    remove.set_defaults(run=_remove)
+    relocate = commands.add_parser(
+        "relocate",
+        help="move an object elsewhere in the panorama (fixed-view constraint)",
+        description=_RELOCATE_DESCRIPTION,
+        epilog=_EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    _scene_arguments(relocate, blend_already_loaded, "the mesh object to move")
+    relocate.add_argument("--yaw", type=float, default=0.0, metavar="DEG",
+                          help="degrees to turn the object about the vertical axis through the probe centre "
+                               "(counter-clockwise seen from above; its orientation turns by the same angle)")
+    relocate.add_argument("--distance-scale", type=float, default=1.0, metavar="S",
+                          help="factor on the object's horizontal distance from that axis (> 0; default 1)")
+    relocate.set_defaults(run=_relocate)
+    return parser
+
+
+def _scene_arguments(parser: argparse.ArgumentParser, blend_already_loaded: bool, object_help: str) -> None:
+    blend_help = "the scene (.blend) to read"
+    if blend_already_loaded:
+        parser.add_argument("blend", nargs="?", metavar="SCENE.blend", help=blend_help + " (default: the open file)")
+    else:
+        parser.add_argument("blend", metavar="SCENE.blend", help=blend_help)
+    parser.add_argument("--object", required=True, metavar="NAME", help=object_help)
+    parser.add_argument(
+        "--plane",
+        action="append",
+        default=[],
+        metavar="NAME",
+        help="a mesh surface to edit (repeatable); without it the surfaces the removal reveals or relights are found",
+    )
+    parser.add_argument("--out", required=True, metavar="DIR", help="output folder (created if needed)")
+    parser.add_argument("--quality", choices=QUALITIES, default="balanced", help=_QUALITY_HELP)
+    parser.add_argument(
+        "--center",
+        nargs=3,
+        type=float,
+        metavar=("X", "Y", "Z"),
+        help="probe centre in world space, overriding the scene's",
+    )
+    parser.add_argument("--verbose", action="store_true", help="print progress and notes on stderr")
+
+
+def _remove(args: argparse.Namespace) -> int:
+    from .. import pipeline
+
+    return _run(args, "removed", lambda scene, **kw: pipeline.remove_object(scene, args.object, **kw))
+
+
+def _relocate(args: argparse.Namespace) -> int:
+    from .. import pipeline
+    from ..relocation.fixedview import Move, check_move
+
+    move = Move(args.yaw, args.distance_scale)
+    # Before the scene is read: a request no placement satisfies needs no .blend.
+    check_move(move)
+    return _run(args, "moved", lambda scene, **kw: pipeline.relocate_object(scene, args.object, move, **kw))
+
+
+def _run(args: argparse.Namespace, done: str, compute: Callable[..., object]) -> int:
+    import bpy
+
+    from . import reader as bridge
+
+    started = time.perf_counter()
+    out = os.path.abspath(args.out)
+    if os.path.exists(out) and not os.path.isdir(out):
+        raise DimredError(f"--out {out} is a file, not a folder")
+    if args.blend is not None:
+        open_blend(args.blend)
+    elif not bpy.data.filepath:
+        raise DimredError("no .blend file is open: pass SCENE.blend")
+    scene = bpy.context.scene
+    bridge.check_object(scene, args.object)
+    for plane in args.plane:
+        if plane == args.object:
+            raise DimredError(f"'{plane}' is the object itself; it cannot also be a --plane")
+        bridge.check_object(scene, plane, purpose="used as a --plane")
+    scene_data = bridge.read_scene(scene, center=args.center)
+    loaded = time.perf_counter()
+    if args.verbose:
+        for note in scene_data.notes:
+            print(f"{PROG}: note: {note}", file=sys.stderr)
+    result = compute(
+        scene_data,
+        planes=list(args.plane),
+        quality=args.quality,
+        progress=_print_progress if args.verbose else None,
+    )
+    report = dict(result.report)
+    seconds = dict(report.get("seconds", {}))
+    seconds["read_scene"] = round(loaded - started, 4)
+    seconds["total"] = round(time.perf_counter() - started, 4)
+    report["seconds"] = seconds
+    images = {"difference.exr": result.difference, "edited.exr": result.edited}
+    mask = result.hidden_mask if report.get("hidden_region_filled") is False else None
+    write_outputs(out, images, mask, report)
+    total = time.perf_counter() - started
+    print(f"{PROG}: {done} '{args.object}' in {total:.1f} s; wrote {out}", flush=True)
+    for warning in report.get("warnings", []):
+        print(f"{PROG}: warning: {warning}", file=sys.stderr)
+    return 0
+
+
+def open_blend(path: str) -> None:
+    """Open a .blend file as the current Blender session; DimredError if it cannot be read."""
+    import bpy
+
+    path = os.path.abspath(path)
+    if not os.path.isfile(path):
+        raise DimredError(f"no such .blend file: {path}")
+    with _captured_stdout() as captured:
+        try:
+            bpy.ops.wm.open_mainfile(filepath=path, load_ui=False)
+        except RuntimeError as error:
+            reason = str(error).strip().removeprefix("Error:").strip() or captured().strip()
+            raise DimredError(f"cannot open {path}: {reason}") from None
+
+
+def write_outputs(out: str, images: dict[str, np.ndarray], mask: np.ndarray | None, report: dict) -> None:
+    """Write the result files into `out`, all or nothing.
+
+    Everything is written into a hidden staging folder first (inside `out` when it exists,
+    else in its deepest existing parent, so the final renames stay on one file system) and
+    moved in only when complete: a failure leaves `out` and earlier results in it as they were.
+    """
+    from ..io.exr import write_exr, write_png
+
+    for name, image in images.items():
+        if not np.all(np.isfinite(image)):
+            raise DimredError(f"the removal produced non-finite values in {name}; nothing was written")
+    try:
+        payload = json.dumps(report, indent=2, allow_nan=False)
+    except (TypeError, ValueError) as error:
+        raise DimredError(f"the removal's report cannot be written as JSON ({error}); nothing was written") from None
+    try:
+        staging = tempfile.mkdtemp(prefix=".dimred-", dir=_existing_folder(out))
+    except OSError as error:
+        raise DimredError(f"cannot write into {out}: {error.strerror or error}") from None
+    try:
+        for name, image in images.items():
+            write_exr(os.path.join(staging, name), image)
+        if mask is not None:
+            write_png(os.path.join(staging, "hidden_mask.png"), np.where(mask, 255, 0).astype(np.uint8))
+        with open(os.path.join(staging, "report.json"), "w", encoding="utf-8") as handle:
+            handle.write(payload + "\n")
+        os.makedirs(out, exist_ok=True)
+        if mask is None:
+            # A mask left from an earlier run would describe a region this result filled.
+            with contextlib.suppress(FileNotFoundError):
+                os.unlink(os.path.join(out, "hidden_mask.png"))
+        for name in os.listdir(staging):
+            os.replace(os.path.join(staging, name), os.path.join(out, name))
+    except OSError as error:
+        raise DimredError(f"cannot write into {out}: {error.strerror or error}") from None
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
+
+
+def _existing_folder(path: str) -> str:
+    """`path` if it is a folder, else the deepest existing folder above it."""
+    folder = path
+    while not os.path.isdir(folder):
+        folder = os.path.dirname(folder)
+    return folder
+
+
+def _print_progress(stage: str, fraction: float) -> None:
+    print(f"{PROG}: {100.0 * fraction:5.1f}% {stage}", file=sys.stderr, flush=True)
+
+
+@contextlib.contextmanager
+def _captured_stdout() -> Iterator[Callable[[], str]]:
+    """Keep Blender's own reports off our stdout while loading: Blender prints them through
+    Python's sys.stdout and through C's buffered stdout (file descriptor 1)."""
+    sys.stdout.flush()
+    _flush_c_stdio()
+    python_level = io.StringIO()
+    with tempfile.TemporaryFile(mode="w+b") as sink:
+        saved = os.dup(1)
+        os.dup2(sink.fileno(), 1)
+
+        def text() -> str:
+            _flush_c_stdio()
+            sink.seek(0)
+            return sink.read().decode("utf-8", "replace") + python_level.getvalue()
+
+        try:
+            with contextlib.redirect_stdout(python_level):
+                yield text
+        finally:
+            _flush_c_stdio()
+            os.dup2(saved, 1)
+            os.close(saved)
+
+
+def _flush_c_stdio() -> None:
+    try:
+        ctypes.CDLL(None).fflush(None)
+    except (OSError, AttributeError, TypeError):
+        # No C runtime reachable this way (Windows): its output may then reach the terminal.
+        pass
+

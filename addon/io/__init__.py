@@ -1,0 +1,1 @@
+"""Files: HDR panoramas and difference images as OpenEXR, previews as PNG."""
