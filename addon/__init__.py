@@ -1,4 +1,5 @@
 """The engine of Diminished Reality: numpy only, importable and testable without Blender.
 
-`bridge` is the one module here that imports bpy; everything else takes and returns arrays.
+Everything here takes and returns arrays; `blender/` is the one sub-package that imports bpy
+(the reader that turns a Blender scene into a `SceneData`, and the command line).
 """

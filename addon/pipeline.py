@@ -5,16 +5,17 @@ The command line, the Blender operators and the tests all call `remove_object` o
 """
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from dataclasses import replace
-from typing import Callable, Sequence
 
 import numpy as np
 
+from .callbacks import NO_CALLBACKS, RunCallbacks
 from .errors import DimredError
+from .quality import DEFAULT_QUALITY, Params, params_for
 from .relocation.fixedview import Move
-from .quality import Params, params_for
 from .relocation.insertion import relocate
-from .removal.stages import RemovalResult, remove
+from .removal import RemovalResult, remove
 from .scene import SceneData
 
 
@@ -26,7 +27,8 @@ def validate(scene: SceneData) -> None:
     if hdri.ndim != 3 or hdri.shape[2] != 3 or hdri.shape[0] < 2 or hdri.shape[1] < 4:
         raise DimredError(f"the world image must be an RGB panorama, got an array of shape {hdri.shape}")
     if hdri.shape[1] != 2 * hdri.shape[0]:
-        raise DimredError(f"the world image is {hdri.shape[1]}x{hdri.shape[0]}: a lat-long panorama is twice as wide as high")
+        raise DimredError(f"the world image is {hdri.shape[1]}x{hdri.shape[0]}: "
+                          "a lat-long panorama is twice as wide as high")
     bad = ~np.isfinite(hdri)
     if bad.any():
         name = scene.hdri_path or "the world image"
@@ -46,45 +48,44 @@ def _run(scene: SceneData, quality: str, overrides: dict, compute: Callable[[Sce
     if negative:
         scene = replace(scene, hdri=np.maximum(scene.hdri, 0.0))
     result = compute(scene, params)
-    result.report["guards"]["negative_input_pixels_clamped"] = negative
-    if negative:
-        result.edited = (original + result.difference).astype(np.float32)
-    result.report["quality"] = quality
-    result.report["parameters"] = {k: getattr(params, k) for k in params.__dataclass_fields__}
-    result.report["image_size"] = [int(scene.hdri.shape[1]), int(scene.hdri.shape[0])]
-    result.report.setdefault("notes", []).extend(scene.notes)
-    return result
+    report = dict(result.report)
+    report["guards"] = {**report["guards"], "negative_input_pixels_clamped": negative}
+    report["quality"] = quality
+    report["parameters"] = {k: getattr(params, k) for k in params.__dataclass_fields__}
+    report["image_size"] = [int(scene.hdri.shape[1]), int(scene.hdri.shape[0])]
+    report["notes"] = [*report.get("notes", []), *scene.notes]
+    edited = (original + result.difference).astype(np.float32) if negative else result.edited
+    return replace(result, edited=edited, report=report)
 
 
 def remove_object(
     scene: SceneData,
     object_name: str,
+    *,
     planes: Sequence[str] = (),
-    quality: str = "balanced",
-    progress: Callable[[str, float], None] | None = None,
-    cancel: Callable[[], bool] | None = None,
-    preview: Callable[[np.ndarray], None] | None = None,
-    **overrides,
+    quality: str = DEFAULT_QUALITY,
+    callbacks: RunCallbacks = NO_CALLBACKS,
+    **overrides: object,
 ) -> RemovalResult:
-    """Remove `object_name` from the scene's panorama; `overrides` change single parameters.
-
-    `preview(difference)` gets coarse difference images before the result (see `removal.remove`)."""
+    """Remove `object_name` from the scene's panorama; `overrides` change single parameters of
+    the quality preset. `callbacks.preview(difference)` gets coarse difference images before
+    the result (see `removal.remove`)."""
     return _run(scene, quality, overrides,
-                lambda s, params: remove(s, object_name, list(planes), params, progress, cancel, preview))
+                lambda s, params: remove(s, object_name, planes=list(planes), params=params, callbacks=callbacks))
 
 
 def relocate_object(
     scene: SceneData,
     object_name: str,
     move: Move,
+    *,
     planes: Sequence[str] = (),
-    quality: str = "balanced",
-    progress: Callable[[str, float], None] | None = None,
-    cancel: Callable[[], bool] | None = None,
-    preview: Callable[[np.ndarray], None] | None = None,
-    **overrides,
+    quality: str = DEFAULT_QUALITY,
+    callbacks: RunCallbacks = NO_CALLBACKS,
+    **overrides: object,
 ) -> RemovalResult:
-    """Move `object_name` under the fixed-view constraint (see `relocation.relocate`): the
-    same images and report as a removal, with `report["relocation"]` describing the move."""
+    """Move `object_name` under the fixed-view constraint (see `relocation.insertion.relocate`):
+    the same images and report as a removal, with `report["relocation"]` describing the move."""
     return _run(scene, quality, overrides,
-                lambda s, params: relocate(s, object_name, move, list(planes), params, progress, cancel, preview))
+                lambda s, params: relocate(s, object_name, move, planes=list(planes), params=params,
+                                           callbacks=callbacks))

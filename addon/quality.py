@@ -1,5 +1,10 @@
 """Quality presets: the parameters that trade accuracy for run time, by name.
 
+The one place that names the presets, describes them and sets every parameter's default: the
+command line's help and choices and the add-on's settings read them from here. This module
+imports nothing beyond the standard library and the error type, so the add-on can read it when
+it registers without loading the engine.
+
 Sizes are relative (to the scene and to the removed object) so a preset means the same on a
 doll's house and on a hall.
 """
@@ -12,7 +17,7 @@ from .errors import DimredError
 
 @dataclass(frozen=True)
 class Params:
-    """Every user-visible knob of a removal (thesis 4.3-4.5 and DESIGN 3)."""
+    """Every user-visible knob of a removal (the method's parameters: docs/design.md, "Parameters")."""
 
     patches: int = 500  # target number of radiosity patches on the room (coarse solution)
     object_patches: int = 100  # target number of patches on the removed object (at least 1 per triangle)
@@ -27,14 +32,27 @@ class Params:
     patch_samples: int = 2  # k*k points average the first-order change over patches near the object
     max_bounces: int = 8  # propagation of the change around the room
     bounce_tolerance: float = 2e-3  # stop when a bounce adds less than this share
-    raster_cell: float = 0.7  # plane raster cell, in panorama pixel footprints where the object was: finer keeps more detail, slower
+    # plane raster cell, in panorama pixel footprints where the object was: finer keeps more detail, slower
+    raster_cell: float = 0.7
     exemplar_margin: float = 1.5  # the raster spans the hole and this many times its extent around it
     synth_neighbourhood: int = 7  # synthesis window (odd): larger follows larger structures, slower
     synth_levels: int = 0  # pyramid levels of the synthesis, 0 = from the hole's size
     synth_generations: int = 2  # synthesis passes per level: more settle seams, slower
     seed: int = 0  # the synthesis's random seed: the same seed gives the same fill
-    insertion_passes: int = 2  # relocation: solver passes towards the inserted object's fixed point (2 at least: the first lacks its reflected light)
+    # relocation: solver passes towards the inserted object's fixed point (2 at least: the first
+    # lacks the object's reflected light)
+    insertion_passes: int = 2
 
+
+#: The preset a run uses unless told otherwise (the command line's and the add-on's default).
+DEFAULT_QUALITY = "balanced"
+
+#: One line per preset, cheapest first: the command line's help and the add-on's quality menu.
+DESCRIPTIONS = {
+    "draft": "Fewest patches, light senders and bounces: fastest, with coarse shadows and relighting",
+    "balanced": "The default trade-off between run time and accuracy",
+    "final": "Most patches, light senders and bounces: slowest and most accurate",
+}
 
 PRESETS = {
     "draft": Params(patches=200, object_patches=40, sender_fraction=0.9, max_senders=12, sender_samples=2,

@@ -5,14 +5,14 @@ It is written as report.json next to the images and shown in Blender's panel.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from typing import Callable, Iterator
 
 
 class Report:
     """Collects what a run did; `as_dict()` is JSON-serialisable."""
 
-    def __init__(self, progress: Callable[[str, float], None] | None = None, stages: int = 1) -> None:
+    def __init__(self, progress: Callable[[str, float], None] | None = None, *, stages: int = 1) -> None:
         self.seconds: dict[str, float] = {}
         self.skipped: dict[str, str] = {}
         self.warnings: list[str] = []

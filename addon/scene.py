@@ -1,7 +1,7 @@
 """Plain-array description of a scene as the engine sees it (no bpy).
 
-The bridge fills a `SceneData` from Blender; tests and the command line hand it to the
-engine. Every array is numpy, world space, metres.
+`addon.blender.reader` fills a `SceneData` from Blender; tests and the command line hand it
+to the engine. Every array is numpy, world space, metres.
 """
 from __future__ import annotations
 
@@ -15,7 +15,7 @@ class SceneData:
     """Everything the removal needs, read once from Blender on the main thread.
 
     hdri: (H, W, 3) float32 linear radiance, row 0 = top of the panorama (v = 1, up); None
-        while still to be read from `hdri_path` (`bridge.read_scene(defer_file=True)`).
+        while still to be read from `hdri_path` (`reader.read_scene(defer_file=True)`).
     rotation: (3, 3) matrix R; the world direction d samples the texture at R @ d
         (identity without a Mapping node).
     center: (3,) probe centre.

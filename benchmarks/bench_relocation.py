@@ -4,8 +4,9 @@ Prints a table: seconds of the removal at the old place and of the insertion pas
 relocation error ratio against the Cycles render with the object at its new place
 (`scenes.metrics.relocation_error_ratio` over both objects and both shadows), the same ratio of
 the best edit smooth at the 3 px scale (the truth's noise), the far damage, and the insertion's
-last residual. Default: `basic_box`, 40 degrees, distance x1.3 (the issue's move). Renders are
-cached under .cache/groundtruth; timings on a shared machine are noisy: compare within one run.
+last residual. Default: `basic_box`, 40 degrees, distance x1.3 (the first move of the relocation
+ground-truth tests). Renders are cached under .cache/groundtruth; timings on a shared machine are
+noisy: compare within one run.
 """
 from __future__ import annotations
 
@@ -15,10 +16,10 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from rendered import arguments, open_scene  # noqa: E402
-from scenes import metrics as M  # noqa: E402
-from scenes import spec as S  # noqa: E402
-from scenes.render import load_pair  # noqa: E402
+from rendered import arguments, open_scene
+from scenes import metrics
+from scenes import spec as scene_specs
+from scenes.render import load_pair
 
 
 def main() -> None:
@@ -27,23 +28,23 @@ def main() -> None:
     ap.add_argument("--yaw", type=float, default=40.0)
     ap.add_argument("--distance-scale", type=float, default=1.3)
     args = ap.parse_args()
-    spec = S.get(args.scene).with_render(width=args.width, height=args.width // 2, samples=args.samples)
+    spec = scene_specs.get(args.scene).with_render(width=args.width, height=args.width // 2, samples=args.samples)
     # Both renders first: Cycles runs in a subprocess, before Blender opens the scene here.
-    truth, _, new_mask = load_pair(S.relocated(spec, args.yaw, args.distance_scale))
-    spec, paths = open_scene(args)
+    truth, _, new_mask = load_pair(scene_specs.relocated(spec, args.yaw, args.distance_scale))
+    spec, _ = open_scene(args)
 
     import bpy
 
-    from addon.blender import reader as bridge
-    from addon.relocation.fixedview import Move
+    from addon.blender import reader
     from addon.pipeline import relocate_object
+    from addon.relocation.fixedview import Move
 
     inp, empty, old_mask = load_pair(spec)
-    scene = bridge.read_scene(bpy.context.scene)
-    region = M.relocation_region(inp, truth, empty, old_mask, new_mask)
-    floor = M.noise_floor(inp, truth, old_mask | new_mask, region)
-    print(f"scene {args.scene} {args.width}x{args.width // 2} @ {args.samples} spp; yaw {args.yaw} x{args.distance_scale};"
-          f" region {int(region.sum())} px; noise floor {floor:.3f}")
+    scene = reader.read_scene(bpy.context.scene)
+    region = metrics.relocation_region(inp, truth, empty, old_mask, new_mask)
+    floor = metrics.noise_floor(inp, truth, old_mask | new_mask, region)
+    print(f"scene {args.scene} {args.width}x{args.width // 2} @ {args.samples} spp; "
+          f"yaw {args.yaw} x{args.distance_scale}; region {int(region.sum())} px; noise floor {floor:.3f}")
     print("| preset | removal s | insertion s | total s | error ratio | far damage |")
     print("|---|---|---|---|---|---|")
     for preset in args.presets.split(","):
@@ -52,8 +53,8 @@ def main() -> None:
         total = time.perf_counter() - t0
         sec = r.report["seconds"]
         removal = sum(v for k, v in sec.items() if k.startswith("removal_"))
-        error = M.relocation_error_ratio(inp, r.edited, truth, region)
-        far = M.far_damage(inp, r.edited, truth, old_mask | new_mask, region=region)
+        error = metrics.relocation_error_ratio(inp, r.edited, truth, region)
+        far = metrics.far_damage(inp, r.edited, truth, old_mask | new_mask, region=region)
         print(f"| {preset} | {removal:.2f} | {total - removal:.2f} | {total:.2f} | {error:.3f} | {far:.3f} |")
 
 

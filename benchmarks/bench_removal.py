@@ -16,8 +16,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from rendered import arguments, open_scene  # noqa: E402
-from scenes import metrics as M  # noqa: E402
+from rendered import arguments, open_scene
+from scenes import metrics
 
 
 def main() -> None:
@@ -28,24 +28,25 @@ def main() -> None:
 
     import bpy
 
-    from addon.blender import reader as bridge
+    from addon.blender import reader
     from addon.pipeline import remove_object
     from scenes.images import read_exr
 
     t0 = time.perf_counter()
-    scene = bridge.read_scene(bpy.context.scene)
+    scene = reader.read_scene(bpy.context.scene)
     read_s = time.perf_counter() - t0
     inp, truth, mask = read_exr(paths["input"]), read_exr(paths["truth"]), np.load(paths["mask"])
-    floor = M.noise_floor(inp, truth, mask)
+    floor = metrics.noise_floor(inp, truth, mask)
     rows = []
     for preset in args.presets.split(","):
         r = remove_object(scene, spec.remove, quality=preset)
-        ratio = M.lighting_error_ratio(inp, r.edited, truth, mask)
-        rows.append((preset, r.report["seconds"], ratio, M.hidden_region_scores(inp, r.edited, truth, mask)))
+        ratio = metrics.lighting_error_ratio(inp, r.edited, truth, mask)
+        rows.append((preset, r.report["seconds"], ratio, metrics.hidden_region_scores(inp, r.edited, truth, mask)))
     stages = [k for k in rows[0][1] if k != "total"]
     print(f"scene {args.scene} {args.width}x{args.width // 2} @ {args.samples} spp; read_scene {read_s:.2f} s;"
           f" noise floor {floor:.3f}")
-    print("| preset | " + " | ".join(stages) + " | total s | error ratio | hidden mean | hidden detail | object + shadow |")
+    print("| preset | " + " | ".join(stages)
+          + " | total s | error ratio | hidden mean | hidden detail | object + shadow |")
     print("|---" * (len(stages) + 6) + "|")
     for preset, sec, ratio, hidden in rows:
         print(f"| {preset} | " + " | ".join(f"{sec[k]:.2f}" for k in stages) + f" | {sec['total']:.2f} | {ratio:.3f}"

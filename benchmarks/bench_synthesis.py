@@ -30,16 +30,16 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
-from typing import Callable
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from addon.synthesis.texture import SynthesisParams, fill  # noqa: E402
-from textures import TEXTURES, lighting  # noqa: E402
+from addon.synthesis.texture import SynthesisParams, fill
+from textures import TEXTURES, lighting
 
 Method = Callable[[np.ndarray, np.ndarray], np.ndarray]  # (image, hole) -> filled image
 
@@ -65,33 +65,34 @@ def biharmonic() -> Method:
 
 
 def patchmatch() -> Method:
-    import patchmatch as pm
+    import patchmatch as patchmatch_lib
 
-    if not pm.patchmatch_available:
+    if not patchmatch_lib.patchmatch_available:
         raise ImportError("the PatchMatch native library did not load")
 
     def run(img, hole):
-        pm.set_random_seed(0)
+        patchmatch_lib.set_random_seed(0)
         # patch radius 3 (7 x 7 patches), as in its examples: its default 15 takes ~8 s per 128 px hole
-        return pm.inpaint(_u8(img), hole.astype(np.uint8) * 255, patch_size=3) / 255.0
+        return patchmatch_lib.inpaint(_u8(img), hole.astype(np.uint8) * 255, patch_size=3) / 255.0
 
     return run
 
 
 def resynthesizer() -> Method:
+    import resynthesizer as resynthesizer_lib
     from PIL import Image
-    import resynthesizer as rs
 
     def run(img, hole):
-        params = rs.getDefaultParams()
+        params = resynthesizer_lib.getDefaultParams()
         params.isMakeSeamlesslyTileableHorizontally = params.isMakeSeamlesslyTileableVertically = 0  # heal
-        out = rs.resynthesize(Image.fromarray(_u8(img)), Image.fromarray(hole.astype(np.uint8) * 255), params)
+        mask = Image.fromarray(hole.astype(np.uint8) * 255)
+        out = resynthesizer_lib.resynthesize(Image.fromarray(_u8(img)), mask, params)
         return np.asarray(out) / 255.0
 
     return run
 
 
-def blur(img: np.ndarray, sigma: float = 2.0) -> np.ndarray:
+def blur(img: np.ndarray, *, sigma: float = 2.0) -> np.ndarray:
     """Separable Gaussian blur of the first two axes, mirrored at the border."""
     r = int(3 * sigma)
     k = np.exp(-0.5 * (np.arange(-r, r + 1) / sigma) ** 2)
@@ -110,7 +111,7 @@ def gradient_magnitude(img: np.ndarray) -> np.ndarray:
     return np.hypot(gy, gx)
 
 
-def border_ring(hole: np.ndarray, width: int = 2) -> np.ndarray:
+def border_ring(hole: np.ndarray, *, width: int = 2) -> np.ndarray:
     """Pixels within `width` of the hole's border, inside and outside."""
     p = np.pad(hole, width)
     shifts = [p[width + dy:width + dy + hole.shape[0], width + dx:width + dx + hole.shape[1]]
@@ -126,10 +127,11 @@ def quality(out: np.ndarray, truth: np.ndarray, hole: np.ndarray) -> tuple[float
     return mae, detail, seam
 
 
-def case_inputs(case: str, texture: np.ndarray, hole: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def case_inputs(case: str, texture: np.ndarray, hole: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """(truth, the image the fills get (0 in the hole), the irradiance that lights it, the irradiance
     after the removal) of one case."""
-    ones = np.ones(texture.shape[:2] + (1,), np.float32)
+    ones = np.ones((*texture.shape[:2], 1), np.float32)
     if case == "plain":
         before = after = ones
     else:

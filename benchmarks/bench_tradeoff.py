@@ -21,8 +21,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from rendered import arguments, open_scene  # noqa: E402
-from scenes import metrics as M  # noqa: E402
+from rendered import arguments, open_scene
+from scenes import metrics
 
 SCENES = ("basic_box", "red_box", "wall_contact", "stool")
 # (label, preset, overrides): each sweep changes one parameter of the balanced preset.
@@ -58,25 +58,26 @@ def _measure(scene_name: str, width: int, samples: int, settings) -> list[dict]:
     """Rows of one scene: every setting's scores and seconds."""
     import bpy
 
-    from addon.blender import reader as bridge
+    from addon.blender import reader
     from addon.pipeline import remove_object
     from scenes.images import read_exr
 
     args = arguments("").parse_args(["--scene", scene_name, "--width", str(width), "--samples", str(samples)])
     spec, paths = open_scene(args)
-    scene = bridge.read_scene(bpy.context.scene)
+    scene = reader.read_scene(bpy.context.scene)
     inp, truth, mask = read_exr(paths["input"]), read_exr(paths["truth"]), np.load(paths["mask"])
-    floor = M.noise_floor(inp, truth, mask)
+    floor = metrics.noise_floor(inp, truth, mask)
     rows = []
     for label, preset, overrides in settings:
         t0 = time.perf_counter()
         result = remove_object(scene, spec.remove, quality=preset, **overrides)
         total = time.perf_counter() - t0
         seconds = result.report["seconds"]
-        hidden = M.hidden_region_scores(inp, result.edited, truth, mask)
+        hidden = metrics.hidden_region_scores(inp, result.edited, truth, mask)
         synthesis = seconds.get("synthesis", 0.0)
         rows.append(dict(setting=label, scenes=scene_name, width=width,
-                         lighting_ratio=M.lighting_error_ratio(inp, result.edited, truth, mask), noise_floor=floor,
+                         lighting_ratio=metrics.lighting_error_ratio(inp, result.edited, truth, mask),
+                         noise_floor=floor,
                          hidden_mean=hidden["mean_ratio"], hidden_detail=hidden["detail_ratio"],
                          object_shadow=hidden["object_shadow_ratio"], lighting_s=total - synthesis,
                          synthesis_s=synthesis, total_s=total))
@@ -96,7 +97,7 @@ def _mean_rows(rows: list[dict], width: int) -> list[dict]:
     return out
 
 
-def pareto(rows: list[dict], cost: str = "total_s", error: str = "lighting_ratio") -> None:
+def pareto(rows: list[dict], *, cost: str = "total_s", error: str = "lighting_ratio") -> None:
     """Mark the rows no other row beats in both `cost` and `error` (row["pareto"])."""
     for row in rows:
         row["pareto"] = not any(o[cost] <= row[cost] and o[error] <= row[error]

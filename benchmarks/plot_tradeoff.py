@@ -13,7 +13,7 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.pyplot as plt
 
 
 def main(argv: list[str]) -> None:
@@ -27,11 +27,11 @@ def main(argv: list[str]) -> None:
     fig, ax = plt.subplots(figsize=(8, 5), dpi=110)
     ax.scatter(seconds, error, s=18, color="tab:blue", zorder=3)
     # The one-parameter sweeps crowd around the balanced preset: name the presets and the front.
-    for r, x, y in zip(rows, seconds, error):
+    for r, x, y in zip(rows, seconds, error, strict=True):
         if r["pareto"] == "True" or r["setting"] in ("draft", "balanced", "final"):
             ax.annotate(r["setting"], (x, y), fontsize=8, xytext=(4, 4), textcoords="offset points")
-    front = sorted((x, y) for r, x, y in zip(rows, seconds, error) if r["pareto"] == "True")
-    ax.plot(*zip(*front), color="tab:red", lw=1.5, label="Pareto front", zorder=2)
+    front = sorted((x, y) for r, x, y in zip(rows, seconds, error, strict=True) if r["pareto"] == "True")
+    ax.plot(*zip(*front, strict=True), color="tab:red", lw=1.5, label="Pareto front", zorder=2)
     ax.axhline(floor, color="grey", ls=":", label=f"noise floor {floor:.3f}")
     ax.axhline(2 * floor, color="grey", ls="--", label="2 x noise floor")
     ax.set_xscale("log")

@@ -7,8 +7,8 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from scenes import spec as S  # noqa: E402
-from scenes.render import render_pair  # noqa: E402
+from scenes import spec as scene_specs
+from scenes.render import render_pair
 
 
 def arguments(description: str) -> argparse.ArgumentParser:
@@ -20,9 +20,9 @@ def arguments(description: str) -> argparse.ArgumentParser:
     return ap
 
 
-def open_scene(args: argparse.Namespace) -> tuple[S.SceneSpec, dict[str, Path]]:
+def open_scene(args: argparse.Namespace) -> tuple[scene_specs.SceneSpec, dict[str, Path]]:
     """Render the pair unless cached, open its .blend in Blender; (spec, paths of the pair)."""
-    spec = S.get(args.scene).with_render(width=args.width, height=args.width // 2, samples=args.samples)
+    spec = scene_specs.get(args.scene).with_render(width=args.width, height=args.width // 2, samples=args.samples)
     paths = render_pair(spec)
     from addon.blender.cli import open_blend  # bpy only after rendering, which runs in a subprocess
 

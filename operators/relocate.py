@@ -1,4 +1,4 @@
-"""The Relocate operator: move the marked object under the fixed-view constraint (DESIGN 6).
+"""The Relocate operator: move the marked object under the fixed-view constraint (docs/design.md).
 
 The move is a yaw about the vertical axis through the probe centre and a factor on the
 object's horizontal distance from it, both counted from where the panorama shows the object
@@ -23,10 +23,10 @@ from bpy.props import BoolProperty, FloatProperty
 from mathutils import Matrix
 
 from ..addon.errors import DimredError
-from .support import session as S
-from .support.relocate_input import RelocateInput
 from .run_operator import RunOperator
 from .settings import DISTANCE_DESCRIPTION, YAW_DESCRIPTION
+from .support import session
+from .support.relocate_input import RelocateInput
 
 if TYPE_CHECKING:  # the engine is imported only when a run starts
     from ..addon.relocation.fixedview import Move
@@ -46,31 +46,31 @@ class Placement:
     photographed: Matrix
     center: np.ndarray
     reference: np.ndarray
-    scene: "SceneData"  # the geometry as the engine will see it, for `refusal`
+    scene: SceneData  # the geometry as the engine will see it, for `refusal`
 
     @classmethod
-    def of_target(cls, context: bpy.types.Context, photographed: Matrix | None = None) -> "Placement":
+    def of_target(cls, context: bpy.types.Context, *, photographed: Matrix | None = None) -> Placement:
         """The placement of `scene.dimred.target` from `photographed` (by default
         `session.photographed_matrix`); DimredError when it cannot be moved."""
-        from ..addon.blender import reader as bridge
+        from ..addon.blender import reader
         from ..addon.relocation.fixedview import reference_point
 
         scene, settings = context.scene, context.scene.dimred
         obj = settings.target
-        bridge.check_object(scene, obj.name, purpose="relocated")
+        reader.check_object(scene, obj.name, purpose="relocated")
         if photographed is None:
-            photographed = S.photographed_matrix(settings, obj)
-        data = S.engine_scene(scene, obj.name, photographed)
+            photographed = session.photographed_matrix(settings, obj)
+        data = session.engine_scene(scene, obj.name, photographed)
         reference = reference_point(data.triangles[data.tri_object == data.object_index(obj.name)])
         return cls(obj.name, photographed, data.center, reference, data)
 
-    def matrix(self, move: "Move") -> Matrix:
+    def matrix(self, move: Move) -> Matrix:
         """The object's world matrix after `move`."""
         from ..addon.relocation.fixedview import move_matrix
 
         return Matrix(move_matrix(self.center, self.reference, move).tolist()) @ self.photographed
 
-    def refusal(self, move: "Move") -> str:
+    def refusal(self, move: Move) -> str:
         """Why the engine would refuse `move` (off the support surface, into a wall or another
         object), or '': checked as the mouse moves, so the tool never confirms a place the run
         would refuse."""
@@ -83,24 +83,24 @@ class Placement:
             return str(error)
         return ""
 
-    def elevation_change(self, move: "Move") -> float:
+    def elevation_change(self, move: Move) -> float:
         from ..addon.relocation.fixedview import elevation_change
 
         return elevation_change(self.center, self.reference, move)
 
 
-def transform_move(context: bpy.types.Context) -> "tuple[Move, Matrix]":
+def transform_move(context: bpy.types.Context) -> tuple[Move, Matrix]:
     """The move the artist made by hand: from the marked object's photographed matrix (its
     relocation's, else where it stood when marked) to where it stands now, and that matrix;
     DimredError for a move the fixed-view constraint forbids (a tilt, a lift, a scale, a turn
     that is not the orbit)."""
-    from ..addon.blender import reader as bridge
+    from ..addon.blender import reader
     from ..addon.relocation.fixedview import move_between
 
     settings = context.scene.dimred
     obj = settings.target
-    bridge.check_object(context.scene, obj.name, purpose="relocated")
-    photographed = S.relocated_matrix(settings, obj.name)
+    reader.check_object(context.scene, obj.name, purpose="relocated")
+    photographed = session.relocated_matrix(settings, obj.name)
     if photographed is None:
         photographed = settings.marked_placement()
     if photographed is None:
@@ -109,7 +109,7 @@ def transform_move(context: bpy.types.Context) -> "tuple[Move, Matrix]":
     if obj.matrix_world == photographed:
         raise DimredError(f"'{obj.name}' stands where the panorama shows it: move it with G and R first, or give "
                           "a yaw and a distance factor")
-    placement = Placement.of_target(context, photographed)
+    placement = Placement.of_target(context, photographed=photographed)
     move = move_between(placement.center, placement.reference, np.array(photographed), np.array(obj.matrix_world))
     return move, photographed
 
@@ -124,7 +124,7 @@ def restore(obj: bpy.types.Object, saved: dict[str, tuple[float, ...]]) -> None:
         setattr(obj, name, value)
 
 
-def _move(yaw: float, distance_scale: float) -> "Move":
+def _move(yaw: float, distance_scale: float) -> Move:
     from ..addon.relocation.fixedview import Move
 
     return Move(yaw=yaw, distance_scale=distance_scale)
@@ -168,7 +168,7 @@ class DIMRED_OT_relocate(RunOperator, bpy.types.Operator):
                     "height), then compute the panorama for that place")
         return cls.bl_description
 
-    def plan(self, context: bpy.types.Context) -> "tuple[Move, Matrix | None]":
+    def plan(self, context: bpy.types.Context) -> tuple[Move, Matrix | None]:
         if not self.from_transform:
             return _move(self.yaw, self.distance_scale), None
         move, photographed = transform_move(context)
@@ -186,7 +186,8 @@ class DIMRED_OT_relocate(RunOperator, bpy.types.Operator):
             return {'CANCELLED'}
         settings = context.scene.dimred
         self._saved = snapshot(settings.target)
-        self._tool = RelocateInput.starting_at(settings.yaw, settings.distance_scale, (event.mouse_x, event.mouse_y))
+        self._tool = RelocateInput.starting_at(settings.yaw, settings.distance_scale,
+                                               mouse=(event.mouse_x, event.mouse_y))
         self._show(context)
         context.window_manager.modal_handler_add(self)
         return {'RUNNING_MODAL'}
@@ -214,7 +215,7 @@ class DIMRED_OT_relocate(RunOperator, bpy.types.Operator):
             self._end_tool(context)
         super().cancel(context)
 
-    def _finish(self, run: S.RemovalSession, ok: bool, context: bpy.types.Context | None = None) -> set[str]:
+    def _finish(self, run: session.RemovalSession, ok: bool, context: bpy.types.Context | None = None) -> set[str]:
         if ok:
             # The panel's fields keep the last relocation, where the tool starts next time.
             settings = bpy.data.scenes[run.scene_name].dimred

@@ -8,14 +8,13 @@ end synchronously. The engine is imported only when a run starts, so registering
 """
 from __future__ import annotations
 
-
 import bpy
 from bpy.props import BoolProperty, StringProperty
 
 from ..addon.errors import DimredError
-from .support import session as S
-from .support import world_layer
 from .run_operator import RunOperator, world_poll
+from .support import session, world_layer
+
 
 class DIMRED_OT_remove(RunOperator, bpy.types.Operator):
     bl_idname = "dimred.remove"
@@ -36,14 +35,14 @@ class DIMRED_OT_cancel(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context: bpy.types.Context) -> bool:
-        if S.active() is None:
+        if session.active() is None:
             cls.poll_message_set("No removal is running")
             return False
         return True
 
     def execute(self, context: bpy.types.Context) -> set[str]:
         # The modal operator sees the request at its next poll and rolls back there.
-        S.active().worker.cancel()
+        session.active().worker.cancel()
         return {'FINISHED'}
 
 
@@ -60,7 +59,7 @@ class DIMRED_OT_clear(bpy.types.Operator):
     def poll(cls, context: bpy.types.Context) -> bool:
         if not world_poll(cls, context):
             return False
-        if S.active() is not None:
+        if session.active() is not None:
             cls.poll_message_set("A removal is running: cancel it first")
             return False
         if not world_layer.has_layer(context.scene.world) and not len(context.scene.dimred.removals):
@@ -97,7 +96,7 @@ class DIMRED_OT_save_hdri(bpy.types.Operator):
     def poll(cls, context: bpy.types.Context) -> bool:
         if not world_poll(cls, context):
             return False
-        if S.active() is not None:
+        if session.active() is not None:
             cls.poll_message_set("A removal is running: wait for it to finish")
             return False
         if world_layer.layer_image(context.scene.world) is None:
@@ -118,11 +117,11 @@ class DIMRED_OT_save_hdri(bpy.types.Operator):
         path = bpy.path.ensure_ext(bpy.path.abspath(self.filepath), ".exr")
         scene = context.scene
         try:
-            from ..addon.blender import reader as bridge
+            from ..addon.blender import reader
             from ..addon.io import exr
 
             difference = world_layer.image_rgb(world_layer.layer_image(scene.world))
-            hdri = bridge.read_scene(scene, S.probe_center(scene.dimred)).hdri
+            hdri = reader.read_scene(scene, center=session.probe_center(scene.dimred)).hdri
             if hdri.shape != difference.shape:
                 raise DimredError(
                     f"The difference image is {difference.shape[1]}x{difference.shape[0]} but the HDRI is "

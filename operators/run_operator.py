@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 import bpy
 
 from ..addon.errors import DimredError
-from .support import session as S
+from .support import session
 
 if TYPE_CHECKING:  # the engine is imported only when a run starts
     from mathutils import Matrix
@@ -33,7 +33,7 @@ class RunOperator:
     Subclasses say what to run with `plan` (no move: remove)."""
 
     _timer = None
-    _session: S.RemovalSession | None = None
+    _session: session.RemovalSession | None = None
 
     @classmethod
     def poll(cls, context: bpy.types.Context) -> bool:
@@ -42,19 +42,19 @@ class RunOperator:
         if context.scene.dimred.target is None:
             cls.poll_message_set("Mark the object to remove first")
             return False
-        if S.active() is not None:
+        if session.active() is not None:
             cls.poll_message_set("A removal is already running: wait for it or cancel it")
             return False
         return True
 
-    def plan(self, context: bpy.types.Context) -> "tuple[Move | None, Matrix | None]":
+    def plan(self, context: bpy.types.Context) -> tuple[Move | None, Matrix | None]:
         """The move to run (None: remove) and the object's photographed matrix (None: the
         session's default); DimredError when the request is refused."""
         return None, None
 
     def execute(self, context: bpy.types.Context) -> set[str]:
         try:
-            run = S.RemovalSession.begin(context, *self.plan(context))
+            run = session.RemovalSession.begin(context, *self.plan(context))
         except DimredError as error:
             self.report({'ERROR'}, str(error))
             return {'CANCELLED'}
@@ -72,7 +72,7 @@ class RunOperator:
         """Begin the session in a worker thread and poll it on a timer; False (reported) when
         the input is refused."""
         try:
-            self._session = S.RemovalSession.begin(context, *self.plan(context))
+            self._session = session.RemovalSession.begin(context, *self.plan(context))
         except DimredError as error:
             self.report({'ERROR'}, str(error))
             return False
@@ -105,7 +105,7 @@ class RunOperator:
         context.workspace.status_text_set(
             f"Diminished Reality: {run.stage.replace('_', ' ')} {100 * run.fraction:.0f} %   (Esc to cancel)")
 
-    def _finish(self, run: S.RemovalSession, ok: bool, context: bpy.types.Context | None = None) -> set[str]:
+    def _finish(self, run: session.RemovalSession, ok: bool, context: bpy.types.Context | None = None) -> set[str]:
         if self._timer is not None and context is not None:
             context.window_manager.event_timer_remove(self._timer)
             self._timer = None

@@ -14,12 +14,13 @@ from bpy.props import (
 )
 from mathutils import Matrix
 
-QUALITY_ITEMS = (
-    ("draft", "Draft", "Fewest patches, light senders and bounces: fastest, coarsest shadows and relighting"),
-    ("balanced", "Balanced", "The default trade-off between run time and accuracy, as on the command line"),
-    ("final", "Final", "Most patches, light senders and bounces: slowest, most accurate"),
-)
+# Standard library and the error type only: reading it keeps registering the add-on cheap.
+from ..addon.quality import DEFAULT_QUALITY, DESCRIPTIONS, Params
 
+QUALITY_ITEMS = tuple((name, name.title(), description) for name, description in DESCRIPTIONS.items())
+
+# Where the override settings start: the engine's own defaults, those of the default preset.
+_DEFAULTS = Params()
 
 # Settings that override the preset's engine parameter of the same name (addon.quality.Params).
 OVERRIDABLE = ("patches", "max_senders", "max_bounces", "raster_cell", "synth_neighbourhood",
@@ -126,10 +127,11 @@ class DimredSettings(bpy.types.PropertyGroup):
     marked_matrix: _matrix_property("Marked Matrix", "The marked object's world matrix when it was marked, row by row")
     surfaces: CollectionProperty(
         name="Surfaces",
-        description="Surfaces to edit; when empty, the surfaces the removal reveals or relights are found automatically",
+        description=("Surfaces to edit; when empty, the surfaces the removal reveals or relights are found "
+                     "automatically"),
         type=DimredSurface,
     )
-    quality: EnumProperty(name="Quality", items=QUALITY_ITEMS, default="balanced")
+    quality: EnumProperty(name="Quality", items=QUALITY_ITEMS, default=DEFAULT_QUALITY)
     output_dir: StringProperty(
         name="Output Folder",
         description="Folder for the difference image (// is the folder of the .blend file)",
@@ -141,40 +143,40 @@ class DimredSettings(bpy.types.PropertyGroup):
         description="Use the parameters below instead of the quality preset's",
     )
     patches: IntProperty(
-        name="Patches", min=20, soft_max=5000, default=500,
+        name="Patches", min=20, soft_max=5000, default=_DEFAULTS.patches,
         description="Radiosity patches on the room: more resolve the light's change on walls and floor "
                     "more finely, and cost time in proportion",
     )
     max_senders: IntProperty(
-        name="Light Senders", min=1, soft_max=256, default=32,
+        name="Light Senders", min=1, soft_max=256, default=_DEFAULTS.max_senders,
         description="Most bright patches (lamps, sunlit areas) whose shadows are traced exactly: more catch "
                     "faint secondary shadows, each one costs a visibility pass",
     )
     max_bounces: IntProperty(
-        name="Bounces", min=0, soft_max=32, default=8,
+        name="Bounces", min=0, soft_max=32, default=_DEFAULTS.max_bounces,
         description="How many times the change of light is passed around the room: more remove the "
                     "object's colour bleeding further away, each costs a transport step",
     )
     raster_cell: FloatProperty(
-        name="Fill Cell", min=0.2, soft_max=3.0, default=0.7,
+        name="Fill Cell", min=0.2, soft_max=3.0, default=_DEFAULTS.raster_cell,
         description="Cell of the plane raster the fill is synthesised on, in panorama pixels: smaller keeps "
                     "finer texture, larger is faster",
     )
     synth_neighbourhood: IntProperty(
-        name="Neighbourhood", min=3, soft_max=15, default=7,
+        name="Neighbourhood", min=3, soft_max=15, default=_DEFAULTS.synth_neighbourhood,
         description="Synthesis window in cells (odd): larger continues larger structures such as tile lines, "
                     "slower",
     )
     synth_generations: IntProperty(
-        name="Generations", min=1, soft_max=6, default=2,
+        name="Generations", min=1, soft_max=6, default=_DEFAULTS.synth_generations,
         description="Synthesis passes per pyramid level: more settle the seams, slower",
     )
     seed: IntProperty(
-        name="Seed", min=0, default=0,
+        name="Seed", min=0, default=_DEFAULTS.seed,
         description="Random seed of the fill: the same seed gives the same result, another seed another fill",
     )
     insertion_passes: IntProperty(
-        name="Insertion Passes", min=1, max=8, default=2,
+        name="Insertion Passes", min=1, max=8, default=_DEFAULTS.insertion_passes,
         description=("Relocate only: solver passes towards the moved object's new shadow and reflected light. "
                      "The first already holds the lamps' shadows; more settle the light it reflects, each costing "
                      "about a removal"),
@@ -185,7 +187,8 @@ class DimredSettings(bpy.types.PropertyGroup):
     storage: EnumProperty(
         name="Store Result",
         items=(
-            ("FILE", "Beside the File", "Write the difference images into the output folder; the .blend refers to them"),
+            ("FILE", "Beside the File",
+             "Write the difference images into the output folder; the .blend refers to them"),
             ("PACK", "Packed", "Pack the difference images into the .blend: one self-contained file, larger to save"),
         ),
         default="FILE",

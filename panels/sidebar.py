@@ -5,9 +5,8 @@ import json
 
 import bpy
 
-from ..operators.support import session
-from ..operators.support import world_layer
 from ..operators.settings import OVERRIDABLE
+from ..operators.support import session, world_layer
 
 CATEGORY = "Diminished Reality"
 
@@ -80,7 +79,8 @@ class DIMRED_PT_main(bpy.types.Panel):
             column.label(text="Removed or relocated, in order:")
             for entry in settings.removals:
                 if entry.kind == 'RELOCATE':
-                    column.label(text=f"{entry.object_name}: yaw {entry.yaw:.1f}°, distance ×{entry.distance_scale:.2f}",
+                    column.label(text=(f"{entry.object_name}: yaw {entry.yaw:.1f}°, "
+                                       f"distance ×{entry.distance_scale:.2f}"),
                                  icon='ORIENTATION_GIMBAL')
                 else:
                     column.label(text=entry.object_name, icon='GHOST_ENABLED')

@@ -3,8 +3,9 @@
 Every surface is a pure Lambertian Diffuse BSDF (the engine's model). Each lamp is a
 two-sided emitting quad filling a hole in the ceiling, closed above by a black housing:
 emission restricted to one side through the shader makes Cycles' light tree mis-estimate the
-lamp (DESIGN section 8). The panoramic camera at the probe centre renders the panorama that the
-World's Environment Texture, through the spec's Mapping rotation, maps back onto the scene.
+lamp, and direct light came out much noisier that way (seen on Blender 5.0). The panoramic
+camera at the probe centre renders the panorama that the World's Environment Texture, through
+the spec's Mapping rotation, maps back onto the scene.
 Expects a fresh session (`bpy.ops.wm.read_factory_settings(use_empty=True)`).
 """
 from __future__ import annotations

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from addon.geometry.latlong import dilate  # noqa: F401  (part of this module's interface)
+from addon.geometry.latlong import dilate  # part of this module's interface, used by the tests as metrics.dilate
 
 _LUMA = np.array([0.2126, 0.7152, 0.0722])
 
@@ -162,7 +162,7 @@ def summary(input: np.ndarray, edit: np.ndarray, truth: np.ndarray,
 
 def hidden_region_scores(input: np.ndarray, edit: np.ndarray, truth: np.ndarray,
                          object_mask: np.ndarray) -> dict[str, float]:
-    """How well the region the object hid was filled (issue 3's figures):
+    """How well the region the object hid was filled, by the figures the ground-truth tests bound:
 
     - `mean_ratio`: mean Y_edit / mean Y_truth over the object's pixels (1 = same brightness);
     - `detail_ratio`: standard deviation of the high-pass Y - box_blur3(Y) over those pixels,

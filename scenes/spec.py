@@ -188,13 +188,13 @@ def _validate(spec: SceneSpec) -> None:
     if spec.remove not in names:
         raise ValueError(f"{spec.name}: object to remove {spec.remove!r} not in {names}")
     lo, hi = spec.room.lo, spec.room.hi
-    if not all(l < p < h for l, p, h in zip(lo, spec.probe, hi)):
+    if not all(low < p < high for low, p, high in zip(lo, spec.probe, hi, strict=True)):
         raise ValueError(f"{spec.name}: probe {spec.probe} outside the room")
     if spec.room.floor.pattern not in FLOOR_PATTERNS:
         raise ValueError(f"{spec.name}: floor pattern {spec.room.floor.pattern!r}")
     for lamp in spec.lamps:
-        for c, s, l, h in zip(lamp.center, lamp.size, lo, hi):
-            if not (l < c - s / 2 and c + s / 2 < h):
+        for c, s, low, high in zip(lamp.center, lamp.size, lo[:2], hi[:2], strict=True):
+            if not (low < c - s / 2 and c + s / 2 < high):
                 raise ValueError(f"{spec.name}: lamp {lamp} not inside the ceiling")
     for o in spec.objects:
         if o.kind not in OBJECT_KINDS:
@@ -341,7 +341,8 @@ def _second_object() -> SceneSpec:
 
 
 def _shadowed_box() -> SceneSpec:
-    room = Room(lo=(-2.0, -2.0, 0.0), hi=(2.6, 2.6, 2.7), floor=Floor("noise", (0.55, 0.5, 0.45), (0.7, 0.66, 0.6), 0.2))
+    room = Room(lo=(-2.0, -2.0, 0.0), hi=(2.6, 2.6, 2.7),
+                floor=Floor("noise", (0.55, 0.5, 0.45), (0.7, 0.66, 0.6), 0.2))
     # A tall cabinet stands between the main lamp and the box: the photograph shows the box in
     # the cabinet's shadow, and a relocation that takes it out of the shadow must brighten it.
     return SceneSpec(

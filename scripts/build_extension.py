@@ -87,17 +87,17 @@ def _run_blender_ext(blender_ext: Path, command: str, *args: str) -> None:
     print(result.stdout.strip(), file=sys.stderr)
 
 
-def validate(blender_ext: Path | None = None) -> None:
+def validate(*, blender_ext: Path | None = None) -> None:
     """Validate the source tree's manifest; SystemExit with blender_ext.py's message if invalid."""
     _run_blender_ext(blender_ext or find_blender_ext(), "validate", str(ROOT))
 
 
-def build(out_dir: Path, split_platforms: bool = False, blender_ext: Path | None = None) -> list[Path]:
+def build(out_dir: Path, *, split_platforms: bool = False, blender_ext: Path | None = None) -> list[Path]:
     """Fetch wheels, validate and build; returns the zip(s) written into out_dir."""
     blender_ext = blender_ext or find_blender_ext()
     data = manifest()
     fetch_wheels(data)
-    validate(blender_ext)
+    validate(blender_ext=blender_ext)
     out_dir = Path(out_dir).resolve()
     out_dir.mkdir(parents=True, exist_ok=True)
     split = ["--split-platforms"] if split_platforms else []
@@ -119,7 +119,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--split-platforms", action="store_true",
                         help="one smaller zip per platform, each with only that platform's wheels")
     args = parser.parse_args(argv)
-    for path in build(args.out_dir, args.split_platforms):
+    for path in build(args.out_dir, split_platforms=args.split_platforms):
         print(path)
     return 0
 

@@ -21,7 +21,7 @@ import numpy as np
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
-from scenes import spec as S  # noqa: E402
+from scenes import spec as scene_specs  # noqa: E402
 from scenes.images import read_exr  # noqa: E402
 from scenes.render import render_pair  # noqa: E402
 
@@ -37,12 +37,12 @@ RELOCATIONS = [("basic_box", 40.0, 1.3), ("stool", 40.0, 1.3), ("rotated_world",
 def _cases() -> list[tuple[str, list[str]]]:
     cases = []
     for name, quality in REMOVALS:
-        spec = S.get(name)
+        spec = scene_specs.get(name)
         blend = str(render_pair(spec)["blend"])
         cases.append((f"remove-{name}-{quality}",
                       ["remove", blend, "--object", spec.remove, "--quality", quality]))
     for name, yaw, scale in RELOCATIONS:
-        spec = S.get(name)
+        spec = scene_specs.get(name)
         blend = str(render_pair(spec)["blend"])
         cases.append((f"relocate-{name}-{yaw:g}-{scale:g}",
                       ["relocate", blend, "--object", spec.remove, "--yaw", str(yaw), "--distance-scale", str(scale)]))

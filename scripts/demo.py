@@ -28,6 +28,7 @@ import numpy as np
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
+from addon.quality import DEFAULT_QUALITY, DESCRIPTIONS  # noqa: E402
 from scenes import metrics, spec  # noqa: E402
 from scenes.images import auto_exposure, read_exr, tonemap, write_png  # noqa: E402
 from scenes.render import pair_paths, render_pair  # noqa: E402
@@ -48,7 +49,7 @@ def main() -> int:
                         help="panorama width in pixels (height = width / 2)")
     parser.add_argument("--samples", type=int, default=demo.render.samples,
                         help="Cycles samples per pixel")
-    parser.add_argument("--quality", default="balanced", choices=("draft", "balanced", "final"))
+    parser.add_argument("--quality", default=DEFAULT_QUALITY, choices=tuple(DESCRIPTIONS))
     parser.add_argument("--yaw", type=float, default=40.0, help="the relocation's yaw in degrees")
     parser.add_argument("--distance-scale", type=float, default=1.3, help="the relocation's distance factor")
     args = parser.parse_args()
@@ -97,7 +98,8 @@ def main() -> int:
 
     relocation = OUT / "relocation"
     seconds = _command(["relocate", str(paths["blend"]), "--object", scene.remove, "--out", str(relocation),
-                        "--quality", args.quality, "--yaw", str(args.yaw), "--distance-scale", str(args.distance_scale)])
+                        "--quality", args.quality, "--yaw", str(args.yaw),
+                        "--distance-scale", str(args.distance_scale)])
     if seconds is None:
         return 1
     shutil.copyfile(relocation / "edited.exr", OUT / "relocated.exr")

@@ -1,152 +1,27 @@
-"""Shared fixtures: the repository imported the way Blender imports the installed extension,
-a fresh Blender session, the tiny room saved as a .blend, and a Cycles render of the world as a
-lat-long panorama.
+"""Collection of the whole suite: the repository root is not imported as a test package.
 
-Blender imports an extension as a package (`bl_ext.<repo>.diminished_reality`) whose modules
-use relative imports; here the repository root becomes the package `diminished_reality`.
+The repository root is the extension's package: its `__init__.py` imports bpy and, through the
+operators, engine modules. pytest sees that file, makes the root a `Package` node and, before the
+first test, imports it under the checkout folder's name (`main`, say) only to look for a
+`setup_module` there. That import would give every run a second copy of the extension and of
+the engine modules it imports (a second `DimredError` class), and would import bpy into engine
+runs, which must show that the engine works without it. Tests import the extension themselves,
+as `diminished_reality` (tests/blender/conftest.py); the root package has no module-level
+setup, so its setup is skipped.
+
+Fixtures live next to the tests that use them: tests/blender/conftest.py (Blender sessions, the
+extension, the tiny room in Blender) and tests/engine/conftest.py (engine runs without bpy).
 """
 from __future__ import annotations
 
-import importlib.util
-import sys
-from pathlib import Path
-from types import ModuleType
-
-import numpy as np
 import pytest
 
-ROOT = Path(__file__).resolve().parent.parent
-PACKAGE = "diminished_reality"
+
+def _skip_setup() -> None:
+    """The repository root's setup: nothing (see the module docstring)."""
 
 
-def import_extension() -> ModuleType:
-    """The repository root as the package `diminished_reality` (imported once per process)."""
-    if PACKAGE not in sys.modules:
-        spec = importlib.util.spec_from_file_location(
-            PACKAGE, ROOT / "__init__.py", submodule_search_locations=[str(ROOT)]
-        )
-        module = importlib.util.module_from_spec(spec)
-        sys.modules[PACKAGE] = module
-        spec.loader.exec_module(module)
-    return sys.modules[PACKAGE]
-
-
-@pytest.fixture(scope="session")
-def extension() -> ModuleType:
-    return import_extension()
-
-
-@pytest.fixture
-def registered(extension: ModuleType):
-    """The add-on registered for one test, on a fresh empty Blender session."""
-    import bpy
-
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    extension.register()
-    try:
-        yield extension
-    finally:
-        extension.unregister()
-
-
-@pytest.fixture
-def fresh_blender():
-    """An empty Blender session (factory settings, no objects) for a test that builds a scene."""
-    import bpy
-
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    yield bpy
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-
-
-@pytest.fixture
-def render_world(tmp_path: Path):
-    """A function that renders the current scene's world with Cycles from `origin` through an
-    equirectangular panoramic camera and returns (height, width, 3) float32, top row first.
-
-    One sample with a 0.01 px Blackman-Harris filter point-samples each pixel's centre
-    direction; the camera rotation (90, 0, -90) degrees makes the render's pixel directions
-    those of `addon.geometry.latlong.pixel_directions`. Keep sizes tiny: the machine is shared.
-    """
-    import tiny_scene
-
-    def render(width: int, height: int, origin: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> np.ndarray:
-        return tiny_scene.render_world(width, height, origin, tmp_path / "render.exr")
-
-    return render
-
-
-@pytest.fixture
-def panorama_world(fresh_blender):
-    """A function that makes the scene's world show `image` through an Environment Texture
-    (Closest interpolation, so a render shows single texels); with `mapping` = (type,
-    rotation, scale) a Texture Coordinate > Mapping chain feeds its vector. Returns the world's
-    node tree."""
-    bpy = fresh_blender
-
-    def build(image, mapping: tuple[str, tuple, tuple] | None = None):
-        world = bpy.data.worlds.new("Probe")
-        bpy.context.scene.world = world
-        if world.node_tree is None:
-            world.use_nodes = True  # Blender 4.x creates worlds without a node tree
-        tree = world.node_tree
-        tree.nodes.clear()
-        output = tree.nodes.new("ShaderNodeOutputWorld")
-        background = tree.nodes.new("ShaderNodeBackground")
-        environment = tree.nodes.new("ShaderNodeTexEnvironment")
-        environment.image = image
-        environment.interpolation = 'Closest'
-        tree.links.new(environment.outputs["Color"], background.inputs["Color"])
-        tree.links.new(background.outputs["Background"], output.inputs["Surface"])
-        if mapping is not None:
-            kind, rotation, scale = mapping
-            coordinates = tree.nodes.new("ShaderNodeTexCoord")
-            node = tree.nodes.new("ShaderNodeMapping")
-            node.vector_type = kind
-            node.inputs["Rotation"].default_value = rotation
-            node.inputs["Scale"].default_value = scale
-            tree.links.new(coordinates.outputs["Generated"], node.inputs["Vector"])
-            tree.links.new(node.outputs["Vector"], environment.inputs["Vector"])
-        return tree
-
-    return build
-
-
-@pytest.fixture
-def room(registered, tmp_path: Path) -> Path:
-    """The tiny room saved as a .blend in tmp_path, with the box marked for removal (draft
-    quality); returns the HDRI's path."""
-    import bpy
-    import tiny_scene
-
-    hdri = tmp_path / "room.exr"
-    tiny_scene.write_exr(hdri, tiny_scene.synthetic_hdri(64, 32))
-    tiny_scene.build_scene(hdri)
-    bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "room.blend"))
-    settings = bpy.context.scene.dimred
-    settings.target = bpy.data.objects["Box"]
-    settings.quality = "draft"
-    return hdri
-
-
-@pytest.fixture
-def drive():
-    """A function that ticks a started RemovalSession the way the modal operator's timer does,
-    until it ends; returns its last state ('FINISHED' or 'CANCELLED')."""
-    import time
-
-    import bpy
-
-    def run(session, poll_interval: float = 0.01, timeout: float = 300.0, on_tick=None) -> str:
-        deadline = time.perf_counter() + timeout
-        while time.perf_counter() < deadline:
-            state = session.tick(bpy.context)
-            if on_tick is not None:
-                on_tick(session)
-            if state != 'RUNNING':
-                return state
-            time.sleep(poll_interval)
-        session.cancel(bpy.context)
-        raise AssertionError("the run did not finish")
-
-    return run
+def pytest_collection_modifyitems(session: pytest.Session, config: pytest.Config, items: list[pytest.Item]) -> None:
+    for node in {node for item in items for node in item.listchain()}:
+        if isinstance(node, pytest.Package) and node.path == config.rootpath:
+            node.setup = _skip_setup

@@ -23,10 +23,11 @@ from collections.abc import Callable, Iterator, Sequence
 
 import numpy as np
 
+from ..callbacks import RunCallbacks
 from ..errors import DimredError
+from ..quality import DEFAULT_QUALITY, DESCRIPTIONS
 
 PROG = "dimred"
-QUALITIES = ("draft", "balanced", "final")
 #: Exit status for bad input (the same as argparse's usage errors).
 EXIT_BAD_INPUT = 2
 
@@ -42,13 +43,13 @@ synthesised from the surface around it. Writes into the output folder:
 
 Files are written only when the whole run succeeds."""
 
-_QUALITY_HELP = "accuracy preset: draft = fastest, balanced = default, final = most accurate (see below)"
+_QUALITY_HELP = f"accuracy preset (default: {DEFAULT_QUALITY}; see the presets below)"
 
-_EPILOG = """\
+_PRESET_LINES = "\n".join(f"  {name:<10} {description}" for name, description in DESCRIPTIONS.items())
+
+_EPILOG = f"""\
 quality presets (--quality):
-  draft      fastest: fewest patches, light senders and bounces; coarse shadows and relighting
-  balanced   the default trade-off between run time and accuracy
-  final      most accurate and slowest: most patches, light senders and bounces
+{_PRESET_LINES}
 
 The probe centre (where the panorama was taken) is --center if given, else the scene's
 Diminished Reality setting or custom property probe_center, else an object named
@@ -86,9 +87,9 @@ def blender_command(argv: Sequence[str]) -> int:
     return run_cli(argv, blend_already_loaded=True)
 
 
-def run_cli(argv: Sequence[str], blend_already_loaded: bool) -> int:
+def run_cli(argv: Sequence[str], *, blend_already_loaded: bool) -> int:
     """Parse `argv` and run the subcommand; returns the exit status."""
-    parser = build_parser(blend_already_loaded)
+    parser = build_parser(blend_already_loaded=blend_already_loaded)
     try:
         args = parser.parse_args(list(argv))
     except SystemExit as stop:
@@ -102,7 +103,7 @@ def run_cli(argv: Sequence[str], blend_already_loaded: bool) -> int:
         return EXIT_BAD_INPUT
 
 
-def build_parser(blend_already_loaded: bool) -> argparse.ArgumentParser:
+def build_parser(*, blend_already_loaded: bool) -> argparse.ArgumentParser:
     """The argument parser; inside Blender SCENE.blend is optional (the open file is used)."""
     parser = argparse.ArgumentParser(
         prog="blender -b SCENE.blend -c dimred" if blend_already_loaded else "python -m addon.cli",
@@ -152,7 +153,7 @@ def _scene_arguments(parser: argparse.ArgumentParser, blend_already_loaded: bool
         help="a mesh surface to edit (repeatable); without it the surfaces the removal reveals or relights are found",
     )
     parser.add_argument("--out", required=True, metavar="DIR", help="output folder (created if needed)")
-    parser.add_argument("--quality", choices=QUALITIES, default="balanced", help=_QUALITY_HELP)
+    parser.add_argument("--quality", choices=tuple(DESCRIPTIONS), default=DEFAULT_QUALITY, help=_QUALITY_HELP)
     parser.add_argument(
         "--center",
         nargs=3,
@@ -166,7 +167,7 @@ def _scene_arguments(parser: argparse.ArgumentParser, blend_already_loaded: bool
 def _remove(args: argparse.Namespace) -> int:
     from .. import pipeline
 
-    return _run(args, "removed", lambda scene, **kw: pipeline.remove_object(scene, args.object, **kw))
+    return _run(args, "removed", lambda scene, **options: pipeline.remove_object(scene, args.object, **options))
 
 
 def _relocate(args: argparse.Namespace) -> int:
@@ -176,13 +177,13 @@ def _relocate(args: argparse.Namespace) -> int:
     move = Move(args.yaw, args.distance_scale)
     # Before the scene is read: a request no placement satisfies needs no .blend.
     check_move(move)
-    return _run(args, "moved", lambda scene, **kw: pipeline.relocate_object(scene, args.object, move, **kw))
+    return _run(args, "moved", lambda scene, **options: pipeline.relocate_object(scene, args.object, move, **options))
 
 
 def _run(args: argparse.Namespace, done: str, compute: Callable[..., object]) -> int:
     import bpy
 
-    from . import reader as bridge
+    from . import reader
 
     started = time.perf_counter()
     out = os.path.abspath(args.out)
@@ -193,12 +194,12 @@ def _run(args: argparse.Namespace, done: str, compute: Callable[..., object]) ->
     elif not bpy.data.filepath:
         raise DimredError("no .blend file is open: pass SCENE.blend")
     scene = bpy.context.scene
-    bridge.check_object(scene, args.object)
+    reader.check_object(scene, args.object)
     for plane in args.plane:
         if plane == args.object:
             raise DimredError(f"'{plane}' is the object itself; it cannot also be a --plane")
-        bridge.check_object(scene, plane, purpose="used as a --plane")
-    scene_data = bridge.read_scene(scene, center=args.center)
+        reader.check_object(scene, plane, purpose="used as a --plane")
+    scene_data = reader.read_scene(scene, center=args.center)
     loaded = time.perf_counter()
     if args.verbose:
         for note in scene_data.notes:
@@ -207,7 +208,7 @@ def _run(args: argparse.Namespace, done: str, compute: Callable[..., object]) ->
         scene_data,
         planes=list(args.plane),
         quality=args.quality,
-        progress=_print_progress if args.verbose else None,
+        callbacks=RunCallbacks(progress=_print_progress if args.verbose else None),
     )
     report = dict(result.report)
     seconds = dict(report.get("seconds", {}))

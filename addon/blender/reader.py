@@ -37,14 +37,14 @@ _PASS_THROUGH_BLENDS = frozenset({"MIX", "ADD"})
 _DIRECTION_OUTPUTS = frozenset({"Generated", "Object"})
 
 
-def read_scene(scene: bpy.types.Scene, center: Sequence[float] | None = None,
+def read_scene(scene: bpy.types.Scene, center: Sequence[float] | None = None, *,
                exclude: Sequence[str] = (), defer_file: bool = False) -> SceneData:
     """Everything the engine needs from `scene`, as numpy arrays in world space.
 
     center overrides the probe centre the scene defines (see `probe_center`). Objects named in
     `exclude` are left out of the geometry (objects already removed from the panorama). With
     `defer_file`, a panorama that can be read straight from its EXR file is not read here:
-    `hdri` is None and `hdri_path` names the file (`removal_job.loaded` reads it later), which
+    `hdri` is None and `hdri_path` names the file (`addon.run.job.loaded` reads it later), which
     keeps Blender's main thread free of the file's decoding.
     """
     notes: list[str] = []
@@ -54,7 +54,7 @@ def read_scene(scene: bpy.types.Scene, center: Sequence[float] | None = None,
     node = environment_texture(scene)
     rotation = texture_rotation(node)
     hdri, path = _panorama(node.image, notes, defer_file)
-    centre = probe_center(scene, center, notes)
+    centre = probe_center(scene, center, notes=notes)
     triangles, tri_object, names = _geometry(scene, notes, frozenset(exclude))
     return SceneData(
         hdri=hdri,
@@ -68,7 +68,7 @@ def read_scene(scene: bpy.types.Scene, center: Sequence[float] | None = None,
     )
 
 
-def check_object(scene: bpy.types.Scene, name: str, purpose: str = "removed") -> None:
+def check_object(scene: bpy.types.Scene, name: str, *, purpose: str = "removed") -> None:
     """DimredError unless `name` is a render-visible mesh of `scene`.
 
     purpose completes "only mesh objects can be ..." in the message.
@@ -89,10 +89,12 @@ def environment_texture(scene: bpy.types.Scene) -> bpy.types.ShaderNodeTexEnviro
     """
     world = scene.world
     if world is None:
-        raise DimredError(f"scene '{scene.name}' has no world: add a World with an Environment Texture holding the HDR panorama")
+        raise DimredError(f"scene '{scene.name}' has no world: add a World with an Environment Texture holding "
+                          "the HDR panorama")
     # World.use_nodes is deprecated from Blender 5.0 on, where world shading always uses nodes.
     if world.node_tree is None or (bpy.app.version < (5, 0, 0) and not world.use_nodes):
-        raise DimredError(f"world '{world.name}' does not use nodes: turn on Use Nodes and add an Environment Texture with the panorama")
+        raise DimredError(f"world '{world.name}' does not use nodes: turn on Use Nodes and add an Environment "
+                          "Texture with the panorama")
     output = world.node_tree.get_output_node("CYCLES")
     if output is None:
         raise DimredError(f"world '{world.name}' has no active World Output node")
@@ -113,7 +115,8 @@ def environment_texture(scene: bpy.types.Scene) -> bpy.types.ShaderNodeTexEnviro
         raise DimredError(f"Environment Texture '{first.name}' in world '{world.name}' has no image")
     if first.projection != "EQUIRECTANGULAR":
         raise DimredError(
-            f"Environment Texture '{first.name}' uses {first.projection} projection: only equirectangular panoramas are supported"
+            f"Environment Texture '{first.name}' uses {first.projection} projection: only equirectangular "
+            "panoramas are supported"
         )
     return first
 
@@ -141,7 +144,8 @@ def texture_rotation(node: bpy.types.ShaderNodeTexEnvironment) -> np.ndarray:
     mapping = source.node
     for socket_name in ("Rotation", "Scale"):
         if mapping.inputs[socket_name].is_linked:
-            raise DimredError(f"Mapping node '{mapping.name}' has its {socket_name} driven by a link: set it as a value")
+            raise DimredError(f"Mapping node '{mapping.name}' has its {socket_name} driven by a link: "
+                              "set it as a value")
     vector = _linked_output(mapping.inputs["Vector"])
     if vector is None:
         # Cycles then maps the constant (0, 0, 0): the whole world shows one texel.
@@ -169,7 +173,8 @@ def texture_rotation(node: bpy.types.ShaderNodeTexEnvironment) -> np.ndarray:
     return rotation @ mirror
 
 
-def probe_center(scene: bpy.types.Scene, center: Sequence[float] | None = None, notes: list[str] | None = None) -> np.ndarray:
+def probe_center(scene: bpy.types.Scene, center: Sequence[float] | None = None, *,
+                 notes: list[str] | None = None) -> np.ndarray:
     """(3,) probe centre: `center`, else the scene's probe_center, else ProbeCenter, else origin.
 
     The scene's value is the add-on setting `scene.dimred.probe_center` when switched on by

@@ -28,7 +28,7 @@ class Clusters:
     representative: np.ndarray  # (C,) index of a member triangle
 
 
-def cluster_triangles(centroids: np.ndarray, normals: np.ndarray, areas: np.ndarray, count: int,
+def cluster_triangles(centroids: np.ndarray, normals: np.ndarray, areas: np.ndarray, *, count: int,
                       size: float, kind: np.ndarray) -> Clusters:
     """Group triangles (centroids (T, 3), unit normals (T, 3), areas (T,)) into about `count`
     clusters; `size` (the object's radius) scales positions against normals (unit length).
@@ -38,7 +38,7 @@ def cluster_triangles(centroids: np.ndarray, normals: np.ndarray, areas: np.ndar
     kinds = np.unique(kind)
     share = np.array([areas[kind == k].sum() for k in kinds]) / areas.sum()
     offset = 0
-    for k, part in zip(kinds, share):
+    for k, part in zip(kinds, share, strict=True):
         sel = np.flatnonzero(kind == k)
         label[sel] = offset + _kmeans(centroids[sel], normals[sel], areas[sel], max(1, round(count * part)), size)
         offset = label[sel].max() + 1
@@ -65,7 +65,7 @@ def _kmeans(centroids: np.ndarray, normals: np.ndarray, areas: np.ndarray, count
     return np.unique(_nearest(features, centres), return_inverse=True)[1]
 
 
-def visibility_samples(clusters: Clusters, centroids: np.ndarray, areas: np.ndarray, k: int
+def visibility_samples(clusters: Clusters, centroids: np.ndarray, areas: np.ndarray, *, k: int
                        ) -> tuple[np.ndarray, np.ndarray]:
     """(C, k) member triangles spread over each cluster (its representative, then each time the
     member farthest from those chosen) and (C, k) the area of the members nearest to each: the

@@ -74,14 +74,6 @@ def sample_bilinear(image: np.ndarray, u: np.ndarray, v: np.ndarray) -> np.ndarr
     return top * (1.0 - fy) + bottom * fy
 
 
-def sample_nearest(image: np.ndarray, u: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """Closest-texel lookup at (u, v), matching the node's Closest interpolation."""
-    h, w = image.shape[:2]
-    x = np.mod(np.floor(np.asarray(u) * w).astype(np.int64), w)
-    y = np.clip(np.floor((1.0 - np.asarray(v)) * h).astype(np.int64), 0, h - 1)
-    return image[y, x]
-
-
 def uv_to_pixel(u: np.ndarray, v: np.ndarray, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
     """Integer (row, column) of the texel containing (u, v)."""
     col = np.mod(np.floor(np.asarray(u) * width).astype(np.int64), width)

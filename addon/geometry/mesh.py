@@ -26,9 +26,6 @@ class Geometry:
     dropped_degenerate: int
     source: np.ndarray  # (T,) row of each triangle in the scene's triangle list
 
-    def object_triangles(self, index: int) -> np.ndarray:
-        return np.flatnonzero(self.tri_object == index)
-
     def object_bounds(self, index: int) -> tuple[np.ndarray, np.ndarray]:
         tris = self.triangles[self.tri_object == index].reshape(-1, 3)
         return tris.min(axis=0), tris.max(axis=0)
@@ -86,15 +83,15 @@ def build_geometry(
     tris = to_probe_frame(triangles, center, rotation)
     if not np.isfinite(tris).all():
         raise DimredError("the scene geometry contains NaN or infinite vertex coordinates")
-    cr = np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0])
-    twice_area = np.linalg.norm(cr, axis=1)
+    cross = np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0])
+    twice_area = np.linalg.norm(cross, axis=1)
     scale = float(np.linalg.norm(tris.reshape(-1, 3).max(axis=0) - tris.reshape(-1, 3).min(axis=0)))
     # Below (1e-4 of the scene's size)^2 a triangle covers far less than a pixel of any panorama
     # and carries no light worth a patch; slivers of that area would only unsettle the patches.
     keep = twice_area > 1e-8 * max(scale, 1e-9) ** 2
-    tris, cr, twice_area = tris[keep], cr[keep], twice_area[keep]
+    tris, cross, twice_area = tris[keep], cross[keep], twice_area[keep]
     tri_object = np.asarray(tri_object)[keep]
-    normals = cr / twice_area[:, None]
+    normals = cross / twice_area[:, None]
     normals = _orient(tris, normals, tri_object, len(object_names))
     return Geometry(
         triangles=tris,
@@ -108,7 +105,7 @@ def build_geometry(
     )
 
 
-def plane_of_object(geometry: Geometry, index: int, tolerance: float = 1e-3) -> tuple[np.ndarray, float] | None:
+def plane_of_object(geometry: Geometry, index: int, *, tolerance: float = 1e-3) -> tuple[np.ndarray, float] | None:
     """(unit normal, offset) if all the object's triangles lie in one plane, else None."""
     sel = geometry.tri_object == index
     if not sel.any():
@@ -154,7 +151,7 @@ def boundary_objects(geometry: Geometry, witnesses: np.ndarray) -> np.ndarray:
     return out
 
 
-def surface_keys(geometry: Geometry, angle_tolerance: float = 1e-3) -> np.ndarray:
+def surface_keys(geometry: Geometry, *, angle_tolerance: float = 1e-3) -> np.ndarray:
     """(T,) an id shared by the triangles of one object that lie in one plane."""
     scale = geometry.scale
     off = np.einsum("ij,ij->i", geometry.normals, geometry.triangles[:, 0])

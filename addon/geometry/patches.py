@@ -84,25 +84,21 @@ class Lattice:
         )
         return patch, self.patch_corners[patch], w
 
-    def sample_points(self, patches: np.ndarray, k: int) -> np.ndarray:
-        """(len(patches), k*k, 3) stratified points: centroids of a level-k split of each patch."""
-        return triangle_samples(self.vertices[self.patch_corners[patches]], k)
-
 
 def build_lattice(triangles: np.ndarray, levels: np.ndarray) -> Lattice:
     """Subdivide triangle t into levels[t]^2 patches (level 0: left out)."""
     levels = np.asarray(levels, dtype=np.int64)
-    nv = np.where(levels > 0, (levels + 1) * (levels + 2) // 2, 0)
-    np_ = levels * levels
-    vertex_offset = np.concatenate([[0], np.cumsum(nv)[:-1]]).astype(np.int64)
-    patch_offset = np.concatenate([[0], np.cumsum(np_)[:-1]]).astype(np.int64)
-    vertices = np.zeros((int(nv.sum()), 3))
-    vertex_tri = np.zeros(int(nv.sum()), dtype=np.int64)
-    corners = np.zeros((int(np_.sum()), 3), dtype=np.int64)
-    patch_tri = np.zeros(int(np_.sum()), dtype=np.int64)
+    vertex_count = np.where(levels > 0, (levels + 1) * (levels + 2) // 2, 0)
+    patch_count = levels * levels
+    vertex_offset = np.concatenate([[0], np.cumsum(vertex_count)[:-1]]).astype(np.int64)
+    patch_offset = np.concatenate([[0], np.cumsum(patch_count)[:-1]]).astype(np.int64)
+    vertices = np.zeros((int(vertex_count.sum()), 3))
+    vertex_tri = np.zeros(int(vertex_count.sum()), dtype=np.int64)
+    corners = np.zeros((int(patch_count.sum()), 3), dtype=np.int64)
+    patch_tri = np.zeros(int(patch_count.sum()), dtype=np.int64)
     for n in np.unique(levels[levels > 0]):
         members = np.flatnonzero(levels == n)
-        st, tmpl = _template(int(n))
+        st, template = _template(int(n))
         a = triangles[members, 0]
         pos = (
             a[:, None, :]
@@ -112,8 +108,8 @@ def build_lattice(triangles: np.ndarray, levels: np.ndarray) -> Lattice:
         vidx = vertex_offset[members][:, None] + np.arange(len(st))[None, :]
         vertices[vidx] = pos
         vertex_tri[vidx] = members[:, None]
-        pidx = patch_offset[members][:, None] + np.arange(len(tmpl))[None, :]
-        corners[pidx] = vertex_offset[members][:, None, None] + tmpl[None]
+        pidx = patch_offset[members][:, None] + np.arange(len(template))[None, :]
+        corners[pidx] = vertex_offset[members][:, None, None] + template[None]
         patch_tri[pidx] = members[:, None]
     return Lattice(levels, vertex_offset, patch_offset, vertices, vertex_tri, corners, patch_tri)
 
@@ -133,13 +129,13 @@ def triangle_samples(tris: np.ndarray, k: int) -> np.ndarray:
     return split_triangles(tris, k).mean(axis=2)
 
 
-def levels_for_size(triangles: np.ndarray, size: np.ndarray | float, max_level: int = 64) -> np.ndarray:
+def levels_for_size(triangles: np.ndarray, size: np.ndarray | float, *, max_level: int = 64) -> np.ndarray:
     """Subdivision level giving patches whose longest edge is about `size` (per triangle or scalar)."""
     edges = np.linalg.norm(triangles - np.roll(triangles, 1, axis=1), axis=2).max(axis=1)
     return np.clip(np.ceil(edges / np.maximum(size, 1e-12)), 1, max_level).astype(np.int64)
 
 
-def levels_for_count(triangles: np.ndarray, target: int, max_level: int = 64) -> np.ndarray:
+def levels_for_count(triangles: np.ndarray, target: int, *, max_level: int = 64) -> np.ndarray:
     """Levels from one common patch size chosen so the total number of patches is near `target`."""
     edges = np.linalg.norm(triangles - np.roll(triangles, 1, axis=1), axis=2).max(axis=1)
     lo, hi = 1e-6 * edges.max(), edges.max()
@@ -147,4 +143,4 @@ def levels_for_count(triangles: np.ndarray, target: int, max_level: int = 64) ->
         mid = np.sqrt(lo * hi)
         count = (np.clip(np.ceil(edges / mid), 1, max_level) ** 2).sum()
         lo, hi = (mid, hi) if count > target else (lo, mid)
-    return levels_for_size(triangles, hi, max_level)
+    return levels_for_size(triangles, hi, max_level=max_level)

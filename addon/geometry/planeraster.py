@@ -73,7 +73,7 @@ def edge_direction(triangles: np.ndarray, normal: np.ndarray) -> np.ndarray:
     return np.cos(angle) * e1 + np.sin(angle) * e2
 
 
-def build_raster(normal: np.ndarray, hidden_points: np.ndarray, cell: float, margin: float,
+def build_raster(normal: np.ndarray, hidden_points: np.ndarray, *, cell: float, margin: float,
                  max_cells: int, along: np.ndarray | None = None) -> PlaneRaster:
     """A raster over the plane of `hidden_points` (N, 3) covering them and `margin` times their
     extent on every side (the exemplar around the hole), its axes as `plane_axes(normal, along)`;
@@ -94,7 +94,7 @@ def build_raster(normal: np.ndarray, hidden_points: np.ndarray, cell: float, mar
 
 def classify(raster: PlaneRaster, surface_with: np.ndarray, distance_with: np.ndarray,
              surface_without: np.ndarray, distance_without: np.ndarray, hidden_by_target: np.ndarray,
-             surface: int, tolerance: float) -> np.ndarray:
+             *, surface: int, tolerance: float) -> np.ndarray:
     """(h, w) SEEN / HIDDEN / OTHER for each cell.
 
     The panorama maps are (H, W): the surface id each pixel's ray hits first and at what
@@ -125,22 +125,22 @@ def sample_panorama(raster: PlaneRaster, image: np.ndarray, valid: np.ndarray) -
     (h, w, C) values and (h, w) the weight the valid pixels had (0 where none)."""
     u, v = latlong.direction_to_uv(raster.points())
     stacked = np.concatenate([image * valid[..., None], valid[..., None].astype(np.float64)], axis=-1)
-    s = latlong.sample_bilinear(stacked, u, v)
-    weight = s[..., -1]
-    values = s[..., :-1] / np.where(weight > 0.0, weight, 1.0)[..., None]
+    sampled = latlong.sample_bilinear(stacked, u, v)
+    weight = sampled[..., -1]
+    values = sampled[..., :-1] / np.where(weight > 0.0, weight, 1.0)[..., None]
     return values, weight
 
 
 def sample_raster(raster: PlaneRaster, image: np.ndarray, points: np.ndarray) -> np.ndarray:
     """Bilinear lookup of a raster image (h, w, C) at points (N, 3) on its plane (clamped)."""
     h, w = raster.shape
-    r, c = raster.coords(points)
-    r = np.clip(r, 0.0, h - 1.0)
-    c = np.clip(c, 0.0, w - 1.0)
-    r0 = np.minimum(np.floor(r).astype(np.int64), max(h - 2, 0))
-    c0 = np.minimum(np.floor(c).astype(np.int64), max(w - 2, 0))
+    row, col = raster.coords(points)
+    row = np.clip(row, 0.0, h - 1.0)
+    col = np.clip(col, 0.0, w - 1.0)
+    r0 = np.minimum(np.floor(row).astype(np.int64), max(h - 2, 0))
+    c0 = np.minimum(np.floor(col).astype(np.int64), max(w - 2, 0))
     r1, c1 = np.minimum(r0 + 1, h - 1), np.minimum(c0 + 1, w - 1)
-    fr, fc = (r - r0)[:, None], (c - c0)[:, None]
-    top = image[r0, c0] * (1.0 - fc) + image[r0, c1] * fc
-    bottom = image[r1, c0] * (1.0 - fc) + image[r1, c1] * fc
-    return top * (1.0 - fr) + bottom * fr
+    row_frac, col_frac = (row - r0)[:, None], (col - c0)[:, None]
+    top = image[r0, c0] * (1.0 - col_frac) + image[r0, c1] * col_frac
+    bottom = image[r1, c0] * (1.0 - col_frac) + image[r1, c1] * col_frac
+    return top * (1.0 - row_frac) + bottom * row_frac

@@ -49,10 +49,10 @@ def _uv_window(tris: np.ndarray, width: int, height: int) -> tuple[np.ndarray, .
     row0 = np.clip(np.floor(np.minimum(rows.min(axis=1), extreme.min(axis=1))) - 2, 0, height - 1).astype(np.int64)
     row1 = np.clip(np.ceil(np.maximum(rows.max(axis=1), extreme.max(axis=1))) + 2, 0, height - 1).astype(np.int64)
     # The u span is the circle minus its largest gap between samples (handles the seam).
-    us = np.sort(u, axis=1)
-    gaps = np.diff(np.concatenate([us, us[:, :1] + 1.0], axis=1), axis=1)
-    g = gaps.argmax(axis=1)
-    start = us[np.arange(len(us)), (g + 1) % us.shape[1]]
+    u_sorted = np.sort(u, axis=1)
+    gaps = np.diff(np.concatenate([u_sorted, u_sorted[:, :1] + 1.0], axis=1), axis=1)
+    widest = gaps.argmax(axis=1)
+    start = u_sorted[np.arange(len(u_sorted)), (widest + 1) % u_sorted.shape[1]]
     span = 1.0 - gaps.max(axis=1)
     col0 = np.floor(start * width).astype(np.int64) - 2
     cols = np.ceil(span * width).astype(np.int64) + 5
@@ -90,53 +90,53 @@ def _edge_extreme_rows(tris: np.ndarray, height: int) -> np.ndarray:
 def _edge_normals(tris: np.ndarray) -> np.ndarray:
     """(T, 3, 3) normals of the planes through the origin and each edge, pointing inward."""
     a, b, c = tris[:, 0], tris[:, 1], tris[:, 2]
-    en = np.stack([np.cross(b, c), np.cross(c, a), np.cross(a, b)], axis=1)
+    normals = np.stack([np.cross(b, c), np.cross(c, a), np.cross(a, b)], axis=1)
     sign = np.sign(np.einsum("ij,ij->i", a, np.cross(b, c)))
-    return en * sign[:, None, None]
+    return normals * sign[:, None, None]
 
 
 def _inside(tris: np.ndarray, dirs: np.ndarray) -> np.ndarray:
     """(T, D) whether directions fall inside each triangle's cone from the origin."""
-    en = _edge_normals(tris)
-    return (np.einsum("tkc,dc->tdk", en, dirs) >= 0.0).all(axis=2)
+    return (np.einsum("tkc,dc->tdk", _edge_normals(tris), dirs) >= 0.0).all(axis=2)
 
 
 def _rasterise(tris, tri_ids, row0, nrows, col0, ncols, dirs, best, out) -> None:
     """Depth-test one batch of triangles that share a window shape into the buffers."""
     h, w = dirs.shape[:2]
-    rr = row0[:, None, None] + np.arange(nrows)[None, :, None]
-    cc = np.mod(col0[:, None, None] + np.arange(ncols)[None, None, :], w)
-    rr = np.broadcast_to(np.minimum(rr, h - 1), (len(tris), nrows, ncols))
-    cc = np.broadcast_to(cc, (len(tris), nrows, ncols))
-    d = dirs[rr, cc]  # (B, nr, nc, 3)
-    en = _edge_normals(tris)
-    lam = np.einsum("bkc,brsc->brsk", en, d)
-    inside = (lam >= -1e-12 * np.abs(lam).max(axis=3, keepdims=True)).all(axis=3)
-    n = np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0])
-    nd = np.einsum("bc,brsc->brs", n, d)
-    na = np.einsum("bc,bc->b", n, tris[:, 0])
+    rows = row0[:, None, None] + np.arange(nrows)[None, :, None]
+    cols = np.mod(col0[:, None, None] + np.arange(ncols)[None, None, :], w)
+    rows = np.broadcast_to(np.minimum(rows, h - 1), (len(tris), nrows, ncols))
+    cols = np.broadcast_to(cols, (len(tris), nrows, ncols))
+    rays = dirs[rows, cols]  # (B, nr, nc, 3)
+    edge_normals = _edge_normals(tris)
+    # Unnormalised barycentric weights: each ray's side of the planes through the origin and an edge.
+    weights = np.einsum("bkc,brsc->brsk", edge_normals, rays)
+    inside = (weights >= -1e-12 * np.abs(weights).max(axis=3, keepdims=True)).all(axis=3)
+    normal = np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0])
+    normal_dot_ray = np.einsum("bc,brsc->brs", normal, rays)
+    normal_dot_corner = np.einsum("bc,bc->b", normal, tris[:, 0])
     with np.errstate(divide="ignore", invalid="ignore"):
-        dist = na[:, None, None] / nd
+        dist = normal_dot_corner[:, None, None] / normal_dot_ray
     ok = inside & (dist > 0.0) & np.isfinite(dist)
     # Rows past the pole were clamped onto the last row: drop the duplicates.
     ok &= (row0[:, None, None] + np.arange(nrows)[None, :, None]) < h
-    b, r, s = np.nonzero(ok)
-    if len(b) == 0:
+    tri, row, col = np.nonzero(ok)
+    if len(tri) == 0:
         return
-    pix = rr[b, r, s] * w + cc[b, r, s]
-    dd = dist[b, r, s]
-    order = np.lexsort((dd, pix))
-    pix, dd, b, r, s = pix[order], dd[order], b[order], r[order], s[order]
+    pix = rows[tri, row, col] * w + cols[tri, row, col]
+    depth = dist[tri, row, col]
+    order = np.lexsort((depth, pix))
+    pix, depth, tri, row, col = pix[order], depth[order], tri[order], row[order], col[order]
     first = np.ones(len(pix), dtype=bool)
     first[1:] = pix[1:] != pix[:-1]
-    pix, dd, b, r, s = pix[first], dd[first], b[first], r[first], s[first]
-    closer = dd < best.ravel()[pix]
-    pix, dd, b, r, s = pix[closer], dd[closer], b[closer], r[closer], s[closer]
-    lk = lam[b, r, s]
-    lk = lk / lk.sum(axis=1, keepdims=True)
-    best.ravel()[pix] = dd
-    out["tri"].ravel()[pix] = tri_ids[b]
-    out["bary"].reshape(-1, 2)[pix] = lk[:, 1:]
+    pix, depth, tri, row, col = pix[first], depth[first], tri[first], row[first], col[first]
+    closer = depth < best.ravel()[pix]
+    pix, depth, tri, row, col = pix[closer], depth[closer], tri[closer], row[closer], col[closer]
+    bary = weights[tri, row, col]
+    bary = bary / bary.sum(axis=1, keepdims=True)
+    best.ravel()[pix] = depth
+    out["tri"].ravel()[pix] = tri_ids[tri]
+    out["bary"].reshape(-1, 2)[pix] = bary[:, 1:]
 
 
 def trace_panorama(triangles: np.ndarray, width: int, height: int) -> PanoramaHits:
@@ -162,7 +162,8 @@ def trace_panorama(triangles: np.ndarray, width: int, height: int) -> PanoramaHi
             else:
                 for m in members:
                     sl = slice(m, m + 1)
-                    _rasterise(triangles[seen[sl]], seen[sl], row0[sl], int(nrows[m]), col0[sl], int(ncols[m]), dirs, best, out)
+                    _rasterise(triangles[seen[sl]], seen[sl], row0[sl], int(nrows[m]), col0[sl], int(ncols[m]),
+                               dirs, best, out)
     distance = np.where(np.isfinite(best), best, 0.0)
     return PanoramaHits(tri=out["tri"], distance=distance, bary=out["bary"], directions=dirs)
 
@@ -191,32 +192,33 @@ class Occluders:
         self.objects = []
         for k in np.unique(tri_object):
             tris = triangles[tri_object == k]
-            cen = tris.mean(axis=1)
+            centroids = tris.mean(axis=1)
             lo_o, hi_o = tris.reshape(-1, 3).min(axis=0), tris.reshape(-1, 3).max(axis=0)
-            q = ((cen - lo_o) / np.maximum(hi_o - lo_o, 1e-12) * 1023).astype(np.int64)
-            tris = tris[np.argsort(_morton(q))]
-            n_cl = -(-len(tris) // _CLUSTER)
+            cells = ((centroids - lo_o) / np.maximum(hi_o - lo_o, 1e-12) * 1023).astype(np.int64)
+            tris = tris[np.argsort(_morton(cells))]
+            n_clusters = -(-len(tris) // _CLUSTER)
             # Padding repeats the last triangle: a duplicate cannot change "any hit".
-            tris = np.concatenate([tris, np.repeat(tris[-1:], n_cl * _CLUSTER - len(tris), axis=0)])
-            flat = tris.reshape(n_cl, _CLUSTER * 3, 3)
-            # Structure of arrays, (9, n_cl, K): v0, e1, e2 by component, for gathers per cluster.
+            tris = np.concatenate([tris, np.repeat(tris[-1:], n_clusters * _CLUSTER - len(tris), axis=0)])
+            flat = tris.reshape(n_clusters, _CLUSTER * 3, 3)
+            # Structure of arrays, (9, n_clusters, K): v0, e1, e2 by component, for gathers per cluster.
             soa = np.concatenate([tris[:, 0], tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0]], axis=1)
-            clo, chi = flat.min(axis=1) - eps, flat.max(axis=1) + eps
+            cluster_lo, cluster_hi = flat.min(axis=1) - eps, flat.max(axis=1) + eps
             # Groups of _CLUSTER consecutive (Morton-ordered, so nearby) clusters: a third level
             # keeps a high-poly object from costing every segment a test per cluster.
-            n_gr = -(-n_cl // _CLUSTER)
-            members = np.arange(n_gr * _CLUSTER)
-            members = np.where(members < n_cl, members, -1).reshape(n_gr, _CLUSTER)[:, : min(n_cl, _CLUSTER)]
+            n_groups = -(-n_clusters // _CLUSTER)
+            members = np.arange(n_groups * _CLUSTER)
+            members = np.where(members < n_clusters, members, -1).reshape(n_groups, _CLUSTER)
+            members = members[:, : min(n_clusters, _CLUSTER)]
             self.objects.append(
                 dict(
                     lo=lo_o - eps,
                     hi=hi_o + eps,
-                    glo=np.where(members[..., None] >= 0, clo[members], np.inf).min(axis=1),
-                    ghi=np.where(members[..., None] >= 0, chi[members], -np.inf).max(axis=1),
+                    glo=np.where(members[..., None] >= 0, cluster_lo[members], np.inf).min(axis=1),
+                    ghi=np.where(members[..., None] >= 0, cluster_hi[members], -np.inf).max(axis=1),
                     members=members,
-                    clo=clo,
-                    chi=chi,
-                    soa=np.ascontiguousarray(soa.T.reshape(9, n_cl, _CLUSTER)),
+                    clo=cluster_lo,
+                    chi=cluster_hi,
+                    soa=np.ascontiguousarray(soa.T.reshape(9, n_clusters, _CLUSTER)),
                 )
             )
 
@@ -237,15 +239,15 @@ class Occluders:
         with np.errstate(divide="ignore"):
             inv = 1.0 / d
         out = np.zeros(len(p0), dtype=bool)
-        for ob in self.objects:
-            cand = np.flatnonzero(~out & _slab(p0, inv, ob["lo"], ob["hi"], tmin, tmax))
+        for obj in self.objects:
+            cand = np.flatnonzero(~out & _slab(p0, inv, obj["lo"], obj["hi"], tmin, tmax))
             if len(cand) == 0:
                 continue
-            si, ci = _descend(p0, inv, tmin, tmax, cand, ob["glo"], ob["ghi"], None)
-            si, ci = _descend(p0, inv, tmin, tmax, si, ob["clo"], ob["chi"], ob["members"][ci])
-            for j0 in range(0, len(si), _PAIR_CHUNK):
-                s = si[j0 : j0 + _PAIR_CHUNK]
-                hit = _moller_trumbore(p0[s], d[s], ob["soa"][:, ci[j0 : j0 + _PAIR_CHUNK]], tmin[s], tmax[s])
+            seg, group = _descend(p0, inv, tmin, tmax, cand, obj["glo"], obj["ghi"], None)
+            seg, cluster = _descend(p0, inv, tmin, tmax, seg, obj["clo"], obj["chi"], obj["members"][group])
+            for j0 in range(0, len(seg), _PAIR_CHUNK):
+                s = seg[j0 : j0 + _PAIR_CHUNK]
+                hit = _moller_trumbore(p0[s], d[s], obj["soa"][:, cluster[j0 : j0 + _PAIR_CHUNK]], tmin[s], tmax[s])
                 out[s[hit]] = True
         return out
 

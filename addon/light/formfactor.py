@@ -27,12 +27,12 @@ def _clip_and_integrate(rel: np.ndarray, n: np.ndarray, eps: float) -> np.ndarra
     """Form factors for triangles `rel` (P, 3, 3), vertices relative to the receiver, normal n (P, 3)."""
     h = np.einsum("pkc,pc->pk", rel, n)  # height of each vertex above the tangent plane
     inside = h > eps
-    nxt = np.roll(np.arange(3), -1)
-    h1 = h[:, nxt]
-    crossing = inside != inside[:, nxt]
-    denom = np.where(crossing, h - h1, 1.0)
+    following = np.roll(np.arange(3), -1)  # the edge from vertex k runs to vertex following[k]
+    h_next = h[:, following]
+    crossing = inside != inside[:, following]
+    denom = np.where(crossing, h - h_next, 1.0)
     s = np.where(crossing, (h - eps) / denom, 0.0)
-    cut = rel + s[..., None] * (rel[:, nxt] - rel)
+    cut = rel + s[..., None] * (rel[:, following] - rel)
     # Sutherland-Hodgman on one plane, as 6 fixed slots (vertex k if inside, then the cut on
     # edge k if the edge crosses); empty slots repeat a valid neighbour so they add nothing.
     slots = np.stack([rel, cut], axis=2).reshape(len(rel), 6, 3)
@@ -45,11 +45,11 @@ def _contour(polygon: np.ndarray, n: np.ndarray) -> np.ndarray:
     """Lambert's formula for polygons (P, K, 3) wholly above the tangent plane (vertices relative
     to the receiver, any length: the edge angle and the projected direction are scale-free)."""
     a, b = polygon, np.roll(polygon, -1, axis=1)
-    cr = np.cross(a, b)
-    crn = np.linalg.norm(cr, axis=-1)
-    angle = np.arctan2(crn, np.einsum("pkc,pkc->pk", a, b))
-    proj = np.einsum("pkc,pc->pk", cr, n)
-    contrib = np.where(crn > 1e-300, angle * proj / np.where(crn > 1e-300, crn, 1.0), 0.0)
+    cross = np.cross(a, b)
+    cross_len = np.linalg.norm(cross, axis=-1)
+    angle = np.arctan2(cross_len, np.einsum("pkc,pkc->pk", a, b))
+    proj = np.einsum("pkc,pc->pk", cross, n)
+    contrib = np.where(cross_len > 1e-300, angle * proj / np.where(cross_len > 1e-300, cross_len, 1.0), 0.0)
     return np.abs(contrib.sum(axis=1)) / (2.0 * np.pi)
 
 
@@ -79,6 +79,7 @@ def point_to_triangle(
     normals: np.ndarray,
     triangles: np.ndarray,
     sender_normals: np.ndarray | None = None,
+    *,
     eps: float = 1e-9,
 ) -> np.ndarray:
     """(R, S) form factors from receiver points (R, 3) with unit normals (R, 3) to triangles (S, 3, 3).
@@ -93,14 +94,14 @@ def point_to_triangle(
     out = np.zeros((r, s))
     if r == 0 or s == 0:
         return out
-    sn = None if sender_normals is None else np.asarray(sender_normals, dtype=np.float64)
+    senders = None if sender_normals is None else np.asarray(sender_normals, dtype=np.float64)
     rows_per_chunk = max(1, _CHUNK // s)
     for r0 in range(0, r, rows_per_chunk):
         x = points[r0 : r0 + rows_per_chunk]
         rel = (triangles[None, :, :, :] - x[:, None, None, :]).reshape(-1, 3, 3)
-        nn = np.repeat(normals[r0 : r0 + rows_per_chunk], s, axis=0)
-        snn = None if sn is None else np.tile(sn, (len(x), 1))
-        out[r0 : r0 + len(x)] = _pairs(rel, nn, snn, eps).reshape(len(x), s)
+        pair_normals = np.repeat(normals[r0 : r0 + rows_per_chunk], s, axis=0)
+        pair_senders = None if senders is None else np.tile(senders, (len(x), 1))
+        out[r0 : r0 + len(x)] = _pairs(rel, pair_normals, pair_senders, eps).reshape(len(x), s)
     return out
 
 
@@ -113,6 +114,6 @@ def paired_point_to_triangle(
     for i0 in range(0, len(points), _CHUNK):
         sl = slice(i0, i0 + _CHUNK)
         rel = np.asarray(triangles[sl], dtype=np.float64) - points[sl, None, :]
-        sn = None if sender_normals is None else np.asarray(sender_normals[sl], dtype=np.float64)
-        out[sl] = _pairs(rel, np.asarray(normals[sl], dtype=np.float64), sn, 1e-9)
+        senders = None if sender_normals is None else np.asarray(sender_normals[sl], dtype=np.float64)
+        out[sl] = _pairs(rel, np.asarray(normals[sl], dtype=np.float64), senders, 1e-9)
     return out

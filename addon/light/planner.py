@@ -18,12 +18,13 @@ def shadow_volume(points: np.ndarray, centres: np.ndarray, radii: np.ndarray, ob
     out = np.zeros((len(points), len(centres)), dtype=bool)
     for s in range(len(centres)):
         d = centres[s] - points
-        t = np.clip(np.einsum("ij,ij->i", obj_centre - points, d) / np.maximum(np.einsum("ij,ij->i", d, d), 1e-300), 0, 1)
+        length2 = np.maximum(np.einsum("ij,ij->i", d, d), 1e-300)
+        t = np.clip(np.einsum("ij,ij->i", obj_centre - points, d) / length2, 0, 1)
         closest = points + t[:, None] * d
         out[:, s] = np.linalg.norm(closest - obj_centre, axis=1) <= obj_radius + radii[s]
     return out
 
 
-def neighbourhood(points: np.ndarray, obj_centre: np.ndarray, obj_radius: float, reach: float) -> np.ndarray:
+def neighbourhood(points: np.ndarray, obj_centre: np.ndarray, obj_radius: float, *, reach: float) -> np.ndarray:
     """(N,) whether the object's bounding sphere covers more than `reach` of the view."""
     return np.linalg.norm(points - obj_centre, axis=1) < obj_radius / np.sqrt(reach)

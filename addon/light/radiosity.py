@@ -8,6 +8,7 @@ radiosity after a removal is shot around the room for as many bounces as it matt
 """
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -26,11 +27,11 @@ def patch_radiosity(
     covers (so the mean is over area, not over pixels).
     """
     n = len(areas)
-    w = np.bincount(patch, weight, minlength=n)
+    seen_area = np.bincount(patch, weight, minlength=n)
     b = np.stack([np.bincount(patch, weight * radiance[:, c], minlength=n) for c in range(3)], axis=1)
     with np.errstate(invalid="ignore", divide="ignore"):
-        b = np.where(w[:, None] > 0.0, np.pi * b / w[:, None], 0.0)
-    return b, np.minimum(w / np.maximum(areas, 1e-300), 1.0)
+        b = np.where(seen_area[:, None] > 0.0, np.pi * b / seen_area[:, None], 0.0)
+    return b, np.minimum(seen_area / np.maximum(areas, 1e-300), 1.0)
 
 
 @dataclass
@@ -42,19 +43,20 @@ class Reflectance:
 
 
 def recover_reflectance(
-    b: np.ndarray, e: np.ndarray, visible: np.ndarray, e_floor: float, e_test: np.ndarray | None = None
+    b: np.ndarray, e: np.ndarray, visible: np.ndarray, e_floor: float, *, e_test: np.ndarray | None = None
 ) -> Reflectance:
     """rho = B / E for visible patches; emitters detected (B above EMITTER_RHO times `e_test`,
     the luminance of E, by default that of `e`); E below `e_floor` guarded."""
-    by, ey = b @ LUMA, e @ LUMA
-    dark = ey <= e_floor
-    emitter = visible & (by > EMITTER_RHO * np.maximum(ey if e_test is None else e_test, e_floor))
+    b_luma, e_luma = b @ LUMA, e @ LUMA
+    dark = e_luma <= e_floor
+    emitter = visible & (b_luma > EMITTER_RHO * np.maximum(e_luma if e_test is None else e_test, e_floor))
     with np.errstate(invalid="ignore", divide="ignore"):
         rho = np.where(e > e_floor, b / np.where(e > e_floor, e, 1.0), 0.0)
     over = visible & ~emitter & (rho >= RHO_MAX).any(axis=1)
     rho = np.clip(rho, 0.0, RHO_MAX)
     rho[emitter] = 0.0
-    return Reflectance(rho=rho, emitter=emitter, clamped=int(over.sum()), guarded=int((visible & dark & ~emitter).sum()))
+    return Reflectance(rho=rho, emitter=emitter, clamped=int(over.sum()),
+                       guarded=int((visible & dark & ~emitter).sum()))
 
 
 def fill_unseen(rho: np.ndarray, measured: np.ndarray, groups: list[np.ndarray], areas: np.ndarray) -> np.ndarray:
@@ -67,21 +69,22 @@ def fill_unseen(rho: np.ndarray, measured: np.ndarray, groups: list[np.ndarray],
         if not todo.any():
             break
         ok = measured & (key >= 0)
-        k = np.where(key >= 0, key, 0)
-        size = int(k.max()) + 1 if len(k) else 1
-        wsum = np.bincount(k[ok], areas[ok], minlength=size)
-        mean = np.stack([np.bincount(k[ok], areas[ok] * rho[ok, c], minlength=size) for c in range(3)], axis=1)
-        has = wsum > 0.0
-        mean = mean / np.where(has, wsum, 1.0)[:, None]
-        take = todo & (key >= 0) & has[k]
-        out[take] = mean[k[take]]
+        group = np.where(key >= 0, key, 0)
+        size = int(group.max()) + 1 if len(group) else 1
+        area_sum = np.bincount(group[ok], areas[ok], minlength=size)
+        mean = np.stack([np.bincount(group[ok], areas[ok] * rho[ok, c], minlength=size) for c in range(3)], axis=1)
+        has = area_sum > 0.0
+        mean = mean / np.where(has, area_sum, 1.0)[:, None]
+        take = todo & (key >= 0) & has[group]
+        out[take] = mean[group[take]]
         todo &= ~take
     out[todo] = fallback
     return out
 
 
 def propagate(
-    db1: np.ndarray, rho: np.ndarray, areas: np.ndarray, gather, tolerance: float, max_bounces: int
+    db1: np.ndarray, rho: np.ndarray, areas: np.ndarray, gather: Callable[[np.ndarray], np.ndarray], *,
+    tolerance: float, max_bounces: int
 ) -> tuple[np.ndarray, int]:
     """Total change sum_k dB_k of radiosity, dB_{k+1} = rho * gather(dB_k), and the bounces used.
 

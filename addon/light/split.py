@@ -10,7 +10,7 @@ pixels take their light; the patch itself carries only the later bounces, which 
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -18,10 +18,10 @@ from ..geometry.patches import split_triangles
 from .transport import Senders, make_senders
 
 
-@dataclass
+@dataclass(frozen=True)
 class Split:
-    """Sub-triangles of split patches, with their light and their transport to the coarse
-    receivers (set once the propagation has computed it)."""
+    """Sub-triangles of split patches, with their light and, once the propagation has computed
+    it (`with_transport`), their transport to the coarse receivers."""
 
     parent: np.ndarray  # (M,) patch of each sub-triangle
     senders: Senders  # (M,) the sub-triangles, sampled at their centroids
@@ -33,11 +33,11 @@ class Split:
 
     @classmethod
     def of(cls, triangles: np.ndarray, normals: np.ndarray, areas: np.ndarray,
-           groups: list[tuple[np.ndarray, int, np.ndarray, np.ndarray]]) -> "Split":
+           groups: list[tuple[np.ndarray, int, np.ndarray, np.ndarray]]) -> Split:
         """Patches (triangles (P, 3, 3), normals (P, 3), areas (P,)) split by groups: patch
         indices (n,), level k, and the radiosity as photographed and its first change at the
         centroids of their k^2 sub-triangles (each (n, k^2, 3), in `split_triangles` order)."""
-        groups = [(np.zeros(0, dtype=np.int64), 1, np.zeros((0, 1, 3)), np.zeros((0, 1, 3)))] + groups
+        groups = [(np.zeros(0, dtype=np.int64), 1, np.zeros((0, 1, 3)), np.zeros((0, 1, 3))), *groups]
         tris = np.concatenate([split_triangles(triangles[g[0]], g[1]).reshape(-1, 3, 3) for g in groups])
         parent = np.concatenate([np.repeat(g[0], g[1] ** 2) for g in groups])
         b = np.concatenate([g[2].reshape(-1, 3) for g in groups])
@@ -47,6 +47,10 @@ class Split:
         senders = make_senders(tris, normals[parent], b, np.zeros(m, dtype=bool),
                                [(np.arange(m), tris.mean(axis=1)[:, None, :])])
         return cls(parent, senders, b, db, sub_areas)
+
+    def with_transport(self, t_with: np.ndarray, t_without: np.ndarray) -> Split:
+        """This split with the coarse receivers' transport from its sub-triangles, (R, M) each."""
+        return replace(self, t_with=t_with, t_without=t_without)
 
     def rest(self, b: np.ndarray) -> np.ndarray:
         """(P, 3) patch radiosities b less what the split patches send through their sub-triangles."""

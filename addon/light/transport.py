@@ -12,17 +12,18 @@ is taken away.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .formfactor import point_to_triangle
 from ..geometry.raycast import Occluders
+from .formfactor import point_to_triangle
 
 _SEGMENTS_PER_CHUNK = 300_000
 
 
-@dataclass
+@dataclass(frozen=True)
 class Parts:
     """Senders made of several triangles (clusters of a finely tessellated object): the member
     triangles, their normals and their sender. Form factors add up over the members."""
@@ -32,7 +33,7 @@ class Parts:
     owner: np.ndarray  # (T,) sender of each member
 
 
-@dataclass
+@dataclass(frozen=True)
 class Senders:
     """Sender patches: triangles, normals, and the visibility sample points of each.
 
@@ -55,16 +56,21 @@ class Senders:
     def __len__(self) -> int:
         return len(self.triangles)
 
-    def resample(self, idx: np.ndarray, samples: np.ndarray, weights: np.ndarray) -> None:
-        """Give senders `idx` new sample points (n, m, 3) with light weights (n, m) >= 0."""
+    def resampled(self, idx: np.ndarray, samples: np.ndarray, weights: np.ndarray) -> Senders:
+        """These senders with `idx` sampled at new points (n, m, 3) with light weights (n, m) >= 0."""
         total = weights.sum(axis=1, keepdims=True)
         weights = np.where(total > 0.0, weights / np.where(total > 0.0, total, 1.0), 1.0 / weights.shape[1])
-        self.group[idx] = len(self.samples)
-        self.slot[idx] = np.arange(len(idx))
-        self.samples.append(samples)
-        self.weights.append(weights)
+        group, slot = self.group.copy(), self.slot.copy()
+        group[idx] = len(self.samples)
+        slot[idx] = np.arange(len(idx))
+        return replace(self, group=group, slot=slot, samples=[*self.samples, samples],
+                       weights=[*self.weights, weights])
 
-    def subset(self, idx: np.ndarray) -> "Senders":
+    def with_radiosity(self, radiosity: np.ndarray) -> Senders:
+        """These senders sending `radiosity` (S, 3)."""
+        return replace(self, radiosity=radiosity)
+
+    def subset(self, idx: np.ndarray) -> Senders:
         """The senders `idx` alone (sharing the sample groups)."""
         parts = None
         if self.parts is not None:
@@ -76,8 +82,8 @@ class Senders:
                        self.group[idx], self.slot[idx], self.samples, self.weights, parts)
 
 
-def make_senders(triangles, normals, radiosity, on_removed, sample_sets: list[tuple[np.ndarray, np.ndarray]],
-                 parts: Parts | None = None) -> Senders:
+def make_senders(triangles: np.ndarray, normals: np.ndarray, radiosity: np.ndarray, on_removed: np.ndarray,
+                 sample_sets: list[tuple[np.ndarray, np.ndarray]], parts: Parts | None = None) -> Senders:
     """Senders from (indices, samples) pairs that together cover every sender once."""
     group = np.zeros(len(triangles), dtype=np.int64)
     slot = np.zeros(len(triangles), dtype=np.int64)
@@ -104,20 +110,21 @@ def form_factors(points: np.ndarray, normals: np.ndarray, senders: Senders) -> n
 
 def pair_visibility(
     points: np.ndarray, senders: Senders, r: np.ndarray, s: np.ndarray, removed: Occluders | None,
-    others: Occluders | None, cancel=None,
+    others: Occluders | None, check: Callable[[], None] | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Visible fractions of sender s[i] from point r[i]: with the removed object, and without it."""
+    """Visible fractions of sender s[i] from point r[i]: with the removed object, and without it.
+    `check()` is called between chunks (it raises to cancel)."""
     vis = np.zeros(len(r))
     vis_without = np.zeros(len(r))
-    for g, (samples, weights) in enumerate(zip(senders.samples, senders.weights)):
+    for g, (samples, weights) in enumerate(zip(senders.samples, senders.weights, strict=True)):
         sel = np.flatnonzero(senders.group[s] == g)
         if not len(sel):
             continue
         m = samples.shape[1]
         per = max(1, _SEGMENTS_PER_CHUNK // m)
         for i0 in range(0, len(sel), per):
-            if cancel is not None:
-                cancel()
+            if check is not None:
+                check()
             k = sel[i0 : i0 + per]
             p0 = np.repeat(points[r[k]], m, axis=0)
             p1 = samples[senders.slot[s[k]]].reshape(-1, 3)
@@ -136,12 +143,12 @@ def transport(
     senders: Senders,
     removed: Occluders | None,
     others: Occluders | None,
-    cancel=None,
+    check: Callable[[], None] | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """(T, T') as dense (R, S) float64 matrices for receivers (R, 3) with normals (R, 3)."""
     f = form_factors(points, normals, senders)
     r, s = np.nonzero(f > 0.0)
-    vis, vis_without = pair_visibility(points, senders, r, s, removed, others, cancel)
+    vis, vis_without = pair_visibility(points, senders, r, s, removed, others, check)
     t_with = np.zeros_like(f)
     t_without = np.zeros_like(f)
     t_with[r, s] = f[r, s] * vis

@@ -1,4 +1,4 @@
-"""The fixed-view constraint of a relocation (DESIGN 6, thesis 5.1), in world space (no bpy).
+"""The fixed-view constraint of a relocation (thesis 5.1, see docs/design.md), in world space (no bpy).
 
 The panorama shows a real object from the probe centre c only, so a move may show no side that
 was not photographed: the object turns about the vertical axis through c by an angle (yaw) and
@@ -100,38 +100,41 @@ def move_between(center: np.ndarray, reference: np.ndarray, before: np.ndarray, 
     `reference` is the object's reference point (world) at `before`."""
     before, after = np.asarray(before, dtype=np.float64), np.asarray(after, dtype=np.float64)
     delta = after @ np.linalg.inv(before)
-    a = delta[:3, :3]
-    sv = np.linalg.svd(a, compute_uv=False)
-    if np.abs(sv - 1.0).max() > 1e-3:
-        raise DimredError(f"the move scales the object (by {sv.min():.3f}..{sv.max():.3f}): a real object keeps its size")
-    tilt = math.degrees(math.acos(float(np.clip(a[2, 2], -1.0, 1.0))))
-    if tilt > _TOLERANCE_DEG or np.linalg.det(a) < 0.0:
+    linear = delta[:3, :3]
+    stretch = np.linalg.svd(linear, compute_uv=False)
+    if np.abs(stretch - 1.0).max() > 1e-3:
+        raise DimredError(
+            f"the move scales the object (by {stretch.min():.3f}..{stretch.max():.3f}): a real object keeps its size"
+        )
+    tilt = math.degrees(math.acos(float(np.clip(linear[2, 2], -1.0, 1.0))))
+    if tilt > _TOLERANCE_DEG or np.linalg.det(linear) < 0.0:
         raise DimredError(
             f"the move tilts the object by {tilt:.1f} degrees: the panorama shows it from one side only, so it may "
             "only turn about the vertical axis"
         )
-    turn = math.degrees(math.atan2(a[1, 0], a[0, 0]))
+    turn = math.degrees(math.atan2(linear[1, 0], linear[0, 0]))
     c = np.asarray(center, dtype=np.float64)
     ref = np.asarray(reference, dtype=np.float64)
     new_ref = apply(delta, ref)
-    h0, h1 = _horizontal(ref - c), _horizontal(new_ref - c)
-    r0, r1 = float(np.linalg.norm(h0)), float(np.linalg.norm(h1))
-    scale_len = max(r0, float(np.linalg.norm(ref - c)), 1e-9)
+    offset_before, offset_after = _horizontal(ref - c), _horizontal(new_ref - c)
+    radius_before, radius_after = float(np.linalg.norm(offset_before)), float(np.linalg.norm(offset_after))
+    scale_len = max(radius_before, float(np.linalg.norm(ref - c)), 1e-9)
     lift = float(new_ref[2] - ref[2])
     if abs(lift) > _TOLERANCE_REL * scale_len:
         raise DimredError(
             f"the move lifts the object by {lift:+.3f} (scene units): it must stay on its support plane, "
             "at the height it was photographed at"
         )
-    if r0 <= _TOLERANCE_REL * scale_len:
+    if radius_before <= _TOLERANCE_REL * scale_len:
         raise DimredError("the object stands on the probe centre's vertical axis: no distance to scale or orbit about")
-    if r1 <= _TOLERANCE_REL * scale_len:
+    if radius_after <= _TOLERANCE_REL * scale_len:
         raise DimredError("the move puts the object on the probe centre's vertical axis (distance factor 0)")
-    orbit = math.degrees(math.atan2(h0[0] * h1[1] - h0[1] * h1[0], h0 @ h1))
+    orbit = math.degrees(math.atan2(offset_before[0] * offset_after[1] - offset_before[1] * offset_after[0],
+                                    offset_before @ offset_after))
     if abs((turn - orbit + 180.0) % 360.0 - 180.0) > _TOLERANCE_DEG:
         raise DimredError(
             f"the object turns by {round(turn, 1) + 0.0} degrees but goes round the probe centre by "
             f"{round(orbit, 1) + 0.0}: under the "
             "fixed-view constraint both are the same angle, so the photographed side keeps facing the probe"
         )
-    return Move(yaw=orbit, distance_scale=r1 / r0)
+    return Move(yaw=orbit, distance_scale=radius_after / radius_before)

@@ -40,8 +40,7 @@ def place(scene: SceneData, target: int, move: Move) -> Placement:
     matrix = fixedview.move_matrix(scene.center, reference, move)
     moved = tris.copy()
     moved[rows] = fixedview.apply(matrix, obj)
-    others = tris[~rows]
-    other_ids = np.asarray(scene.tri_object)[~rows]
+    others = _Others(tris[~rows], np.asarray(scene.tri_object)[~rows], scene.object_names)
     pts = obj.reshape(-1, 3)
     size = float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0)))
     height = float(np.ptp(pts[:, 2]))
@@ -49,30 +48,7 @@ def place(scene: SceneData, target: int, move: Move) -> Placement:
     # A foot stands on a surface within `gap` above or below it: proxies are modelled by hand,
     # sunk into the floor a little or floating above it.
     gap = _SUPPORT_GAP * max(height, size * 1e-2)
-
-    feet = np.unique(pts[pts[:, 2] <= pts[:, 2].min() + 1e-2 * max(height, 1e-9)], axis=0)
-    down = np.broadcast_to([0.0, 0.0, -1.0], feet.shape)
-    hit, t = first_hits(feet + [0.0, 0.0, gap], down, others)
-    stands = t <= 2.0 * gap
-    if not stands.any():
-        raise DimredError(
-            f"'{name}' does not stand on a surface (nothing within {gap:.3g} of its lowest points): a "
-            "relocation keeps an object on its support plane, so model the surface it stands on"
-        )
-    new_feet = fixedview.apply(matrix, feet[stands])
-    hit_new, t_new = first_hits(new_feet + [0.0, 0.0, gap], down[: len(new_feet)], others)
-    # The support is a plane, not an object: a floor modelled in pieces, or a rug on it, holds
-    # the object as well at the same height.
-    off = t_new > 2.0 * gap
-    if off.any():
-        was_on = ", ".join(repr(scene.object_names[k]) for k in np.unique(other_ids[hit[stands]]))
-        below = sorted({scene.object_names[other_ids[k]] for k in hit_new[off] if k >= 0})
-        where = f"over {', '.join(repr(n) for n in below)} at another height" if below else "over nothing"
-        raise DimredError(
-            f"at the new place '{name}' would not stand on its support plane (where {was_on} holds it now): "
-            f"{int(off.sum())} of its feet would be {where}. Choose a smaller move"
-        )
-    support = [scene.object_names[k] for k in np.unique(other_ids[hit_new])]
+    support = _support_at_new_place(name, pts, height, gap, matrix, others)
 
     new_pts = moved[rows].reshape(-1, 3)
     centre = np.asarray(scene.center, dtype=np.float64)
@@ -84,12 +60,51 @@ def place(scene: SceneData, target: int, move: Move) -> Placement:
     lifted = [t.copy() for t in (obj, moved[rows])]
     for t in lifted:
         t[..., 2] = np.maximum(t[..., 2], floor_z)
-    collided = _collisions(*lifted, others, other_ids, 1e-6 * max(scene_size, 1e-9))
+    collided = _collisions(*lifted, others.triangles, others.ids, 1e-6 * max(scene_size, 1e-9))
     if collided:
-        raise DimredError(
-            f"at the new place '{name}' would cut through {', '.join(repr(scene.object_names[k]) for k in collided)}"
-        )
+        raise DimredError(f"at the new place '{name}' would cut through {others.listed(collided)}")
     return Placement(matrix, moved, support, fixedview.elevation_change(scene.center, reference, move))
+
+
+@dataclass
+class _Others:
+    """The scene's triangles other than the object's, with their objects' indices and the names."""
+
+    triangles: np.ndarray  # (T, 3, 3)
+    ids: np.ndarray  # (T,) object index of each triangle
+    names: list[str]  # the scene's object names, by index
+
+    def listed(self, objects) -> str:
+        return ", ".join(repr(self.names[k]) for k in objects)
+
+
+def _support_at_new_place(name: str, pts: np.ndarray, height: float, gap: float, matrix: np.ndarray,
+                          others: _Others) -> list[str]:
+    """The objects the object's feet (its lowest points `pts`) stand on after the move `matrix`,
+    or a DimredError when it stands on nothing now or would not stand on its support plane there."""
+    feet = np.unique(pts[pts[:, 2] <= pts[:, 2].min() + 1e-2 * max(height, 1e-9)], axis=0)
+    down = np.broadcast_to([0.0, 0.0, -1.0], feet.shape)
+    hit, t = first_hits(feet + np.array([0.0, 0.0, gap]), down, others.triangles)
+    stands = t <= 2.0 * gap
+    if not stands.any():
+        raise DimredError(
+            f"'{name}' does not stand on a surface (nothing within {gap:.3g} of its lowest points): a "
+            "relocation keeps an object on its support plane, so model the surface it stands on"
+        )
+    new_feet = fixedview.apply(matrix, feet[stands])
+    hit_new, t_new = first_hits(new_feet + np.array([0.0, 0.0, gap]), down[: len(new_feet)], others.triangles)
+    # The support is a plane, not an object: a floor modelled in pieces, or a rug on it, holds
+    # the object as well at the same height.
+    off = t_new > 2.0 * gap
+    if off.any():
+        was_on = others.listed(np.unique(others.ids[hit[stands]]))
+        below = sorted({others.names[others.ids[k]] for k in hit_new[off] if k >= 0})
+        where = f"over {', '.join(repr(n) for n in below)} at another height" if below else "over nothing"
+        raise DimredError(
+            f"at the new place '{name}' would not stand on its support plane (where {was_on} holds it now): "
+            f"{int(off.sum())} of its feet would be {where}. Choose a smaller move"
+        )
+    return [others.names[k] for k in np.unique(others.ids[hit_new])]
 
 
 def _collisions(before: np.ndarray, after: np.ndarray, others: np.ndarray, other_ids: np.ndarray,
@@ -98,25 +113,29 @@ def _collisions(before: np.ndarray, after: np.ndarray, others: np.ndarray, other
     their closed mesh), where its old place did not (a model that already touched a wall a
     little is not refused for that)."""
     found = []
-    # Not straight up: a box's centre lies under the diagonal its top face's two triangles
-    # share, and a ray along that edge would count the face twice.
-    up = np.array([[0.0123, 0.0271, 1.0]])
     for k in np.unique(other_ids):
         tris = others[other_ids == k]
-        occ = Occluders(tris, other_ids[other_ids == k], eps)
+        occluders = Occluders(tris, other_ids[other_ids == k], eps)
         # Inside and outside mean something for a closed mesh only (a ceiling with lamp holes
         # is crossed once or not at all, wherever one stands).
         closed = _closed(tris, eps)
-
-        def collides(obj: np.ndarray) -> bool:
-            a = obj.reshape(-1, 3)
-            b = np.roll(obj, -1, axis=1).reshape(-1, 3)
-            inside = closed and crossings(fixedview.reference_point(obj)[None], up, tris)[0] % 2 == 1
-            return bool(inside or occ.blocked(a, b).any())
-
-        if collides(after) and not collides(before):
+        if _collides(after, tris, occluders, closed=closed) and not _collides(before, tris, occluders, closed=closed):
             found.append(int(k))
     return found
+
+
+# Not straight up: a box's centre lies under the diagonal its top face's two triangles share,
+# and a ray along that edge would count the face twice.
+_UP = np.array([[0.0123, 0.0271, 1.0]])
+
+
+def _collides(obj: np.ndarray, tris: np.ndarray, occluders: Occluders, *, closed: bool) -> bool:
+    """Whether the object's triangles (n, 3, 3) cut the other object `tris` (its edges cross it)
+    or sit inside it (its centre inside a closed mesh)."""
+    edge_starts = obj.reshape(-1, 3)
+    edge_ends = np.roll(obj, -1, axis=1).reshape(-1, 3)
+    inside = closed and crossings(fixedview.reference_point(obj)[None], _UP, tris)[0] % 2 == 1
+    return bool(inside or occluders.blocked(edge_starts, edge_ends).any())
 
 
 def _closed(triangles: np.ndarray, eps: float) -> bool:

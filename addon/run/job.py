@@ -3,11 +3,12 @@
 
 The operator gathers a `RemovalRequest` on the main thread and runs `run` either in a worker
 thread or, in background mode, directly. A request with a `move` relocates the object (removal
-at the photographed place, insertion at the moved one) and is otherwise handled the same. Removals compose: the request carries the difference
-of the objects removed before (`base`), the engine works on HDRI + base, and the world layer
-shows base + this run's difference. Files are written under temporary names next to their
-final paths and only `Staged.commit` (on the main thread, once the run is accepted) renames them
-into place, so a cancelled or failed run leaves earlier results as they were.
+at the photographed place, insertion at the moved one) and is otherwise handled the same.
+Removals compose: the request carries the difference of the objects removed before (`base`),
+the engine works on HDRI + base, and the world layer shows base + this run's difference. Files
+are written under temporary names next to their final paths and only `Staged.commit` (on the
+main thread, once the run is accepted) renames them into place, so a cancelled or failed run
+leaves earlier results as they were.
 """
 from __future__ import annotations
 
@@ -16,14 +17,15 @@ import functools
 import os
 import secrets
 from dataclasses import dataclass, field, replace
-from typing import Callable
 
 import numpy as np
 
-from ..errors import Cancelled, DimredError
+from ..callbacks import NO_CALLBACKS, RunCallbacks
+from ..errors import DimredError
 from ..io.exr import read_exr, write_exr
-from ..relocation.fixedview import Move
 from ..pipeline import relocate_object, remove_object
+from ..quality import DEFAULT_QUALITY
+from ..relocation.fixedview import Move
 from ..scene import SceneData
 
 
@@ -32,7 +34,7 @@ class RemovalRequest:
     scene: SceneData  # hdri None: read from scene.hdri_path in the worker, off the main thread
     object_name: str
     planes: tuple[str, ...] = ()
-    quality: str = "balanced"
+    quality: str = DEFAULT_QUALITY
     base: np.ndarray | None = None  # (H, W, 3) difference of the objects removed before
     own_path: str = ""  # where this removal's own difference goes
     layer_path: str = ""  # where base + own difference (what the world shows) goes
@@ -65,7 +67,7 @@ class RemovalOutcome:
 
 
 def loaded(scene: SceneData) -> SceneData:
-    """`scene` with its panorama read from `hdri_path` if the bridge deferred it."""
+    """`scene` with its panorama read from `hdri_path` if the reader deferred it."""
     if scene.hdri is not None:
         return scene
     if not scene.hdri_path:
@@ -81,14 +83,9 @@ def blender_pixels(image: np.ndarray) -> np.ndarray:
     return rgba.ravel()
 
 
-def run(
-    request: RemovalRequest,
-    progress: Callable[[str, float], None] | None = None,
-    cancel: Callable[[], bool] | None = None,
-    preview: Callable[[np.ndarray], None] | None = None,
-) -> RemovalOutcome:
-    """Remove (or relocate) the requested object; `preview` gets the layer (base + difference so far) as
-    `blender_pixels` buffers, ready for the main thread to show."""
+def run(request: RemovalRequest, callbacks: RunCallbacks = NO_CALLBACKS) -> RemovalOutcome:
+    """Remove (or relocate) the requested object; `callbacks.preview` gets the layer (base +
+    difference so far) as `blender_pixels` buffers, ready for the main thread to show."""
     scene = loaded(request.scene)
     base = request.base
     if base is not None:
@@ -98,14 +95,13 @@ def run(
                 f"{scene.hdri.shape[1]}x{scene.hdri.shape[0]}: clear them and remove again"
             )
         scene = replace(scene, hdri=(scene.hdri + base).astype(np.float32))
-    show = None if preview is None else (
-        lambda difference: preview(blender_pixels(difference if base is None else difference + base)))
+    engine_callbacks = callbacks.mapped_preview(
+        lambda difference: blender_pixels(difference if base is None else difference + base))
     engine = remove_object if request.move is None else functools.partial(relocate_object, move=request.move)
-    result = engine(scene, request.object_name, planes=request.planes, quality=request.quality, progress=progress,
-                    cancel=cancel, preview=show, **request.overrides)
+    result = engine(scene, request.object_name, planes=request.planes, quality=request.quality,
+                    callbacks=engine_callbacks, **request.overrides)
     layer = result.difference if base is None else (result.difference + base).astype(np.float32)
-    if cancel is not None and cancel():
-        raise Cancelled()
+    callbacks.check()
     staged = Staged()
     try:
         for path, image in ((request.own_path, result.difference), (request.layer_path, layer)):

@@ -8,15 +8,15 @@ preview is kept, so a slow main thread never piles up images.
 from __future__ import annotations
 
 import threading
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, Callable, Generic, TypeVar
+from typing import Any, Generic, TypeVar
 
+from ..callbacks import RunCallbacks
 from ..errors import Cancelled
 
 T = TypeVar("T")
-ProgressFn = Callable[[str, float], None]
-PreviewFn = Callable[[Any], None]
-Task = Callable[[ProgressFn, Callable[[], bool], PreviewFn], T]
+Task = Callable[[RunCallbacks], T]
 
 
 @dataclass
@@ -32,10 +32,11 @@ class Update(Generic[T]):
 
 
 class Worker(Generic[T]):
-    """Runs `task(progress, cancelled, preview)` in a daemon thread.
+    """Runs `task(callbacks)` in a daemon thread.
 
-    The task reports with `progress(stage, fraction)` and `preview(obj)` and should check
-    `cancelled()` often (the engine does between steps) and raise `Cancelled` when it is True.
+    The task reports with `callbacks.progress(stage, fraction)` and `callbacks.preview(obj)` and
+    should call `callbacks.check()` often (the engine does between steps), which raises
+    `Cancelled` once the worker is cancelled.
     """
 
     def __init__(self, task: Task, name: str = "dimred-worker") -> None:
@@ -48,7 +49,7 @@ class Worker(Generic[T]):
         self._delivered = False
         self._thread = threading.Thread(target=self._run, name=name, daemon=True)
 
-    def start(self) -> "Worker[T]":
+    def start(self) -> Worker[T]:
         self._thread.start()
         return self
 
@@ -59,10 +60,6 @@ class Worker(Generic[T]):
     @property
     def cancelled(self) -> bool:
         return self._cancel.is_set()
-
-    @property
-    def alive(self) -> bool:
-        return self._thread.is_alive()
 
     def join(self, timeout: float | None = None) -> bool:
         """Wait for the thread; True when it has ended."""
@@ -102,11 +99,11 @@ class Worker(Generic[T]):
         result: T | None = None
         error: BaseException | None = None
         try:
-            result = self._task(self._progress, self._cancel.is_set, self._show)
+            result = self._task(RunCallbacks(self._progress, self._cancel.is_set, self._show))
             if self._cancel.is_set():
                 # Cancelled after the last check: the result must not be applied.
                 raise Cancelled()
-        except BaseException as exc:  # noqa: BLE001 - every failure goes back to the main thread
+        except BaseException as exc:
             result, error = None, exc
         with self._lock:
             self._preview = None

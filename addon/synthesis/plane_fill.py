@@ -1,20 +1,20 @@
 """What the removed object hid from the probe: reflectance synthesised on the plane, lit anew.
 
-Reflectance, not radiance, is synthesised (DESIGN 3.6): rho = pi L / E carries no shadow, so the
+Reflectance, not radiance, is synthesised: rho = pi L / E carries no shadow, so the
 shadow gradients around the object cannot leak into the fill, and the filled floor is then lit
 by the irradiance after the removal, L' = rho E' / pi. Synthesis runs on a rectified raster of
-the revealed plane (`planeraster`), the exemplar being the same surface's visible cells around
+the revealed plane (`geometry.planeraster`), the exemplar being the same surface's visible cells around
 the hole.
 """
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 
-from ..geometry import planeraster as PR
-from ..errors import Cancelled, DimredError
+from ..errors import DimredError
+from ..geometry import planeraster
 from .texture import SynthesisParams, fill
 
 _MAX_CELLS = 512 * 512  # bounds the raster (and the exemplar) whatever the panorama size
@@ -22,7 +22,7 @@ _DEPTH_TOLERANCE = 0.02  # relative: a cell is where a ray meets its surface wit
 _MIN_KNOWN = 64  # visible cells a surface needs to serve as its own exemplar
 
 
-@dataclass
+@dataclass(frozen=True)
 class PanoramaMaps:
     """(H, W) per pixel: the surface id and distance of the first hit with the object and
     without it (-1 where nothing is hit), and whether the object is the first hit."""
@@ -34,7 +34,39 @@ class PanoramaMaps:
     hidden: np.ndarray
 
 
-@dataclass
+@dataclass(frozen=True)
+class PanoramaReflectance:
+    """What the panorama tells about reflectance: (H, W, 3) rho = pi L / E, (H, W) where it
+    was measured, and the surfaces each pixel sees."""
+
+    rho: np.ndarray
+    valid: np.ndarray
+    maps: PanoramaMaps
+
+
+@dataclass(frozen=True)
+class HiddenPlane:
+    """The hidden points (N, 3) of one plane: its surface id, unit normal, and the direction
+    the raster's axes follow on a floor or ceiling (`planeraster.plane_axes`), or None."""
+
+    surface: int
+    normal: np.ndarray
+    points: np.ndarray
+    along: np.ndarray | None = None
+
+
+@dataclass(frozen=True)
+class FillOptions:
+    """The raster's cell size (about the panorama's pixel footprint there), the exemplar margin
+    (times the hole's extent around it), the synthesis's parameters and its seed."""
+
+    cell: float
+    margin: float
+    synthesis: SynthesisParams
+    seed: int = 0
+
+
+@dataclass(frozen=True)
 class SurfaceFill:
     rho: np.ndarray  # (N, 3) reflectance at the hidden points
     raster_shape: tuple[int, int]
@@ -45,30 +77,26 @@ class SurfaceFill:
 
 
 def fill_surface(
-    maps: PanoramaMaps,
-    rho_image: np.ndarray,
-    rho_valid: np.ndarray,
-    surface: int,
-    normal: np.ndarray,
-    points: np.ndarray,
-    cell: float,
-    margin: float,
-    params: SynthesisParams,
-    seed: int = 0,
+    panorama: PanoramaReflectance,
+    plane: HiddenPlane,
+    options: FillOptions,
+    *,
     cancel: Callable[[], bool] | None = None,
     progress: Callable[[np.ndarray], None] | None = None,
-    along: np.ndarray | None = None,
 ) -> SurfaceFill:
-    """Reflectance at the hidden `points` (N, 3) of one plane, synthesised on a raster with cells
-    of about `cell` covering them and `margin` times their extent around, from the panorama's
-    reflectance `rho_image` (H, W, 3) where `rho_valid`; the raster's axes follow `along` on a
-    floor or ceiling (`planeraster.plane_axes`). `progress(rho)` gets the (N, 3)
-    reflectance at `points` after each synthesis level, coarsest first."""
-    raster = PR.build_raster(normal, points, cell, margin, _MAX_CELLS, along)
-    flags = PR.classify(raster, maps.surface_with, maps.distance_with, maps.surface_without,
-                        maps.distance_without, maps.hidden, surface, _DEPTH_TOLERANCE)
-    values, weight = PR.sample_panorama(raster, rho_image, rho_valid & (maps.surface_with == surface))
-    known = (flags == PR.SEEN) & (weight > 0.5)
+    """Reflectance at the plane's hidden points, synthesised on a raster covering them and the
+    options' margin around, from the panorama's reflectance where it is valid and shows this
+    surface. `progress(rho)` gets the (N, 3) reflectance at the points after each synthesis
+    level, coarsest first."""
+    maps, points = panorama.maps, plane.points
+    raster = planeraster.build_raster(plane.normal, points, cell=options.cell, margin=options.margin,
+                                      max_cells=_MAX_CELLS, along=plane.along)
+    flags = planeraster.classify(raster, maps.surface_with, maps.distance_with, maps.surface_without,
+                                 maps.distance_without, maps.hidden, surface=plane.surface,
+                                 tolerance=_DEPTH_TOLERANCE)
+    values, weight = planeraster.sample_panorama(raster, panorama.rho,
+                                                 panorama.valid & (maps.surface_with == plane.surface))
+    known = (flags == planeraster.SEEN) & (weight > 0.5)
     # The hidden points are looked up bilinearly: fill the cells around each as well.
     r, c = (np.floor(x).astype(np.int64) for x in raster.coords(points))
     hole = np.zeros(raster.shape, dtype=bool)
@@ -76,21 +104,19 @@ def fill_surface(
     for dr in (0, 1):
         for dc in (0, 1):
             hole[np.clip(r + dr, 0, h - 1), np.clip(c + dc, 0, w - 1)] = True
-    hole |= flags == PR.HIDDEN
+    hole |= flags == planeraster.HIDDEN
     hole &= ~known
     mean = values[known].mean(axis=0) if known.any() else np.zeros(3)
     image = np.where(known[..., None], values, mean)
     synthesised = False
     if known.sum() >= _MIN_KNOWN:
         on_level = None if progress is None else (
-            lambda _level, preview: progress(PR.sample_raster(raster, preview, points)))
+            lambda _level, preview: progress(planeraster.sample_raster(raster, preview, points)))
         try:
-            image = fill(image, known, hole, params, seed=seed, progress=on_level, cancel=cancel)
+            image = fill(image, known, hole, options.synthesis, seed=options.seed, progress=on_level, cancel=cancel)
             synthesised = True
-        except Cancelled:
-            raise
         except DimredError:
             pass  # too little exemplar: the mean below is the honest fallback, reported by the caller
-    rho = PR.sample_raster(raster, image, points)
+    rho = planeraster.sample_raster(raster, image, points)
     return SurfaceFill(rho=rho, raster_shape=raster.shape, cell=raster.cell, known_cells=int(known.sum()),
                        hole_cells=int(hole.sum()), synthesised=synthesised)

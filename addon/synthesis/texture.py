@@ -24,8 +24,8 @@ of (seed, level, generation, y, x), never a sequential stream.
 """
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
@@ -107,6 +107,7 @@ def fill(
     known: np.ndarray,
     hole: np.ndarray,
     params: SynthesisParams = SynthesisParams(),
+    *,
     exemplar: np.ndarray | None = None,
     exemplar_valid: np.ndarray | None = None,
     seed: int = 0,
@@ -123,7 +124,8 @@ def fill(
     `cancel()` returning True raises `Cancelled` at the next step. Raises `DimredError` on bad input
     or an exemplar with too few complete neighbourhoods.
     """
-    synth = OrderIndependentSynthesis(image, known, hole, params, exemplar, exemplar_valid, seed, cancel)
+    synth = OrderIndependentSynthesis(image, known, hole, params, exemplar=exemplar, exemplar_valid=exemplar_valid,
+                                      seed=seed, cancel=cancel)
     if progress is not None:  # without it, level 0 computes of the coarser levels just what it reads
         for level in range(synth.levels - 1, 0, -1):
             progress(level, synth.preview(level))
@@ -147,62 +149,39 @@ class OrderIndependentSynthesis:
         known: np.ndarray,
         hole: np.ndarray,
         params: SynthesisParams = SynthesisParams(),
+        *,
         exemplar: np.ndarray | None = None,
         exemplar_valid: np.ndarray | None = None,
         seed: int = 0,
         cancel: CancelFn | None = None,
     ) -> None:
         image, known, hole = _check_inputs(image, known, hole, params)
-        if exemplar is None:
-            if not known.any():
-                raise DimredError("nothing is known around the hole: there is no exemplar to synthesise from")
-            ex_image, ex_valid = image, known & _nearest_pixels(known, hole, params.max_exemplar)
-        else:
-            ex_image, ex_valid = _check_exemplar(exemplar, exemplar_valid, image.shape[2])
-            centre = np.zeros(ex_valid.shape, bool)
-            centre[ex_valid.shape[0] // 2, ex_valid.shape[1] // 2] = True
-            ex_valid = ex_valid & _nearest_pixels(ex_valid, centre, params.max_exemplar)
+        ex_image, ex_valid = _exemplar_source(image, known, hole, params.max_exemplar, exemplar, exemplar_valid)
         self._params, self._seed, self._cancel = params, seed, cancel
         self._image, self._hole0 = image, hole
-        n, c = params.neighbourhood, image.shape[2]
-        lo, hi = float(ex_image[ex_valid].min()), float(ex_image[ex_valid].max())
-        self._lo = lo
-        self._qmax = min(255, int(np.sqrt(_EXACT / ((n * n + 9) * c))))  # bytes, and exact squared distances
-        self._scale = self._qmax / (hi - lo) if hi > lo else 1.0
-
-        levels = params.levels or _auto_levels(hole, n)
+        self._quantiser = _Quantiser.spanning(ex_image[ex_valid], params.neighbourhood, image.shape[2])
+        levels = params.levels or _auto_levels(hole, params.neighbourhood)
         ex_pyr = pyramid(ex_image, ex_valid.astype(np.float32), levels)
-        while True:
-            coarsest = self._exemplar_level(ex_pyr, levels - 1, levels)
-            if len(coarsest.pos) >= MIN_WINDOWS or params.levels or levels == 1:
-                break
-            levels -= 1
-        self.levels = levels
-        self._ex = [self._exemplar_level(ex_pyr, l, levels) for l in range(levels - 1)] + [coarsest]
-        for l, ex in enumerate(self._ex):
-            if len(ex.pos) < MIN_WINDOWS:
-                raise DimredError(
-                    f"the exemplar has only {len(ex.pos)} complete {n}x{n} neighbourhoods on pyramid level {l} "
-                    f"(at least {MIN_WINDOWS} needed): give a larger exemplar region, fewer levels or a smaller "
-                    "neighbourhood"
-                )
+        self._ex = _exemplar_levels(ex_pyr, params, self._quantiser)  # automatic levels may drop the coarsest
+        self.levels = len(self._ex)
 
-        known_pyr = pyramid(image, known.astype(np.float32), levels)
-        hole_pyr = pyramid(None, hole.astype(np.float32), levels)
+        known_pyr = pyramid(image, known.astype(np.float32), self.levels)
+        hole_pyr = pyramid(None, hole.astype(np.float32), self.levels)
         self._hole = [w > 0 for _, w in hole_pyr]
-        known_l = [(w > 0) & ~h for (_, w), h in zip(known_pyr, self._hole)]
-        self._known = known_l
-        self._care = [k | h for k, h in zip(known_l, self._hole)]
-        self._seams: list[np.ndarray | None] = [None] * levels
-        self._gens = [params.finest_generations] + [params.generations] * (levels - 1)  # searches per level
+        self._known = [(w > 0) & ~h for (_, w), h in zip(known_pyr, self._hole, strict=True)]
+        self._care = [k | h for k, h in zip(self._known, self._hole, strict=True)]
+        self._seams: list[np.ndarray | None] = [None] * self.levels
+        self._gens = [params.finest_generations] + [params.generations] * (self.levels - 1)  # searches per level
         # per level and generation: the image (known pixels, and the hole as far as computed), the
         # exemplar window each hole pixel copies, and which are computed; generation 0 is the start
         # (`_start`), generations 1..g the searches
         self._img = [[np.where(k[..., None], v, 0).astype(np.float32) for _ in range(g + 1)]
-                     for (v, _), k, g in zip(known_pyr, known_l, self._gens)]
-        self._src = [[np.full(h.shape, -1, np.int64) for _ in range(g + 1)] for h, g in zip(self._hole, self._gens)]
-        self._done = [[np.zeros(h.shape, bool) for _ in range(g + 1)] for h, g in zip(self._hole, self._gens)]
-        self._offsets = self._find_offsets(known_pyr, known_l, ex_pyr) if params.offsets else None
+                     for (v, _), k, g in zip(known_pyr, self._known, self._gens, strict=True)]
+        levels_gens = list(zip(self._hole, self._gens, strict=True))
+        self._src = [[np.full(h.shape, -1, np.int64) for _ in range(g + 1)] for h, g in levels_gens]
+        self._done = [[np.zeros(h.shape, bool) for _ in range(g + 1)] for h, g in levels_gens]
+        self._offsets = (_find_offsets(self._hole, self._known, known_pyr, ex_pyr, self._ex, params)
+                         if params.offsets else None)
 
     def pixels(self, level: int, ys: np.ndarray, xs: np.ndarray) -> np.ndarray:
         """Final values (M, C) of pixels (ys, xs) of `level`: synthesised in the hole (with the
@@ -240,7 +219,8 @@ class OrderIndependentSynthesis:
             border = self._hole[l] & _dilate(self._known[l], 1)
             if self._params.smooth_seams and border.any():
                 self._ensure(l, self._gens[l], border)
-                values, weight = self._border_mismatch(l, border)
+                values, weight = _border_mismatch(self._ex[l], self._img[l][-1], self._src[l][-1], self._known[l],
+                                                  border)
                 fixed = weight > 0
                 # the membrane takes each border value as it is: outliers (border pixels whose
                 # reflectance is off where the irradiance estimate is poor, as in a contact shadow)
@@ -248,21 +228,6 @@ class OrderIndependentSynthesis:
                 field = _harmonic(_robust(values, fixed), fixed, self._hole[l])
             self._seams[l] = np.where(self._hole[l][..., None], field, 0).astype(np.float32)
         return self._seams[l]
-
-    def _border_mismatch(self, l: int, border: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Per known pixel next to the hole: its value minus what the copies of its hole neighbours
-        hold at its place (averaged over them), and which pixels have one."""
-        ex, img = self._ex[l], self._img[l][-1]
-        total, count = np.zeros(img.shape, np.float32), np.zeros(img.shape[:2], np.float32)
-        ys, xs = np.nonzero(border)
-        src = ex.pos[self._src[l][-1][ys, xs]]
-        for dy, dx in _STEPS4:
-            copy, ok = _sample(ex.values, ex.valid, src[:, 0] + dy, src[:, 1] + dx)
-            qy, qx = ys + dy, xs + dx
-            ok &= _lookup(self._known[l].astype(np.int8), qy, qx) > 0
-            total[qy[ok], qx[ok]] += img[qy[ok], qx[ok]] - copy[ok]  # one hole neighbour per direction
-            count[qy[ok], qx[ok]] += 1
-        return total / np.maximum(count, 1)[..., None], (count > 0).astype(np.float32)
 
     def _ensure(self, l: int, g: int, want: np.ndarray) -> None:
         """Compute the hole pixels of `want` on level l, generation g, after what they depend on."""
@@ -290,11 +255,12 @@ class OrderIndependentSynthesis:
         idx = self._random(l, 0, ys, xs, 0)
         ex = self._ex[l]
         if l + 1 < self.levels:
-            ps = self._src[l + 1][-1][ys // 2, xs // 2]
-            parent = self._ex[l + 1].pos[ps]
+            parent_src = self._src[l + 1][-1][ys // 2, xs // 2]
+            parent = self._ex[l + 1].pos[parent_src]
             up = _lookup(ex.index, 2 * parent[:, 0] + ys % 2, 2 * parent[:, 1] + xs % 2)
             idx = np.where(up >= 0, up, idx)
-        if self._offsets is None:
+        if self._offsets is None or not len(self._offsets[l]):
+            # No shift qualified (the exemplar is too small to hold the hole shifted by one).
             return idx
         cand = self._offset_candidates(l, ys, xs)
         if l + 1 < self.levels:
@@ -317,7 +283,8 @@ class OrderIndependentSynthesis:
         coarse = None if l + 1 == self.levels else (self._img[l + 1][-1], self._care[l + 1])
         # only the pixels' windows are read: quantise and upsample just their bounding box
         box = _bounding_box(ys, xs, max(self._params.neighbourhood // 2, 2), self._hole[l].shape)
-        q, ok = _gather(self._quantised_planes(self._img[l][g - 1], self._care[l], coarse, box), ys - box[0], xs - box[2])
+        planes = self._quantiser.planes(self._img[l][g - 1], self._care[l], coarse, box)
+        q, ok = _gather(planes, ys - box[0], xs - box[2])
         w = ok.astype(np.float32)
         ex = self._ex[l]
         if self._params.search == "exhaustive":
@@ -334,11 +301,11 @@ class OrderIndependentSynthesis:
             p = ex.pos[np.maximum(s, 0)]
             cands.append(np.where(s >= 0, _lookup(ex.index, p[:, 0] - dy, p[:, 1] - dx), -1))
         if l + 1 < self.levels:
-            csrc, cpos = self._src[l + 1][-1], self._ex[l + 1].pos
+            coarse_src, coarse_pos = self._src[l + 1][-1], self._ex[l + 1].pos
             for dy, dx in _WINDOW3:
                 cy, cx = ys // 2 + dy, xs // 2 + dx
-                s = _lookup(csrc, cy, cx)
-                p = cpos[np.maximum(s, 0)]
+                s = _lookup(coarse_src, cy, cx)
+                p = coarse_pos[np.maximum(s, 0)]
                 c = _lookup(ex.index, 2 * p[:, 0] + ys - 2 * cy, 2 * p[:, 1] + xs - 2 * cx)
                 cands.append(np.where(s >= 0, c, -1))
         cands += [self._random(l, g, ys, xs, j) for j in range(self._params.random_candidates)]
@@ -346,54 +313,127 @@ class OrderIndependentSynthesis:
             cands += list(self._offset_candidates(l, ys, xs).T)
         return np.stack(cands, axis=1)
 
-    def _find_offsets(self, known_pyr: list, known_l: list, ex_pyr: list) -> list[np.ndarray]:
-        """Per level, the (K, 2) offsets t under which the known ring around the hole best matches
-        the exemplar at ring + t. A pool of shifts is ranked on the coarsest level over all shifts
-        (by FFT), refined by -1..1 and halved on every finer level, and cut to the K best on the
-        finest level, where the ring shows the most detail. Row k is one offset on all levels."""
-        top = self.levels - 1
-        rings = [_dilate(h, self._params.neighbourhood // 2 + 1) & k for h, k in zip(self._hole, known_l)]
-        valid = [w >= 1 - 1e-6 for _, w in ex_pyr]
-        offsets = [None] * self.levels
-        offsets[top] = _rank_offsets(known_pyr[top][0], rings[top], self._hole[top], ex_pyr[top][0], valid[top],
-                                     self._ex[top].index >= 0, _OFFSET_POOL)
-        keep = np.arange(len(offsets[top]))
-        for l in range(top - 1, -1, -1):
-            # halve the pool on each level, the finer levels judging the fewer, better shifts
-            t, score = _refine_offsets(2 * offsets[l + 1][keep], known_pyr[l][0], rings[l], ex_pyr[l][0], valid[l])
-            offsets[l] = np.zeros_like(offsets[top])
-            offsets[l][keep] = t
-            keep = keep[np.argsort(score, kind="stable")[:max(self._params.offsets, len(keep) // 2)]]
-        return [t[keep[:self._params.offsets]] for t in offsets]
-
     def _random(self, l: int, g: int, ys: np.ndarray, xs: np.ndarray, j: int) -> np.ndarray:
         """A random exemplar window per pixel, a function of (seed, level, generation, y, x, j) alone."""
         return (_hash(self._seed, ys, xs, l, g, j) % np.uint64(len(self._ex[l].pos))).astype(np.int64)
 
-    def _quantised_planes(self, level: np.ndarray, ok: np.ndarray, coarse: tuple | None,
-                          box: tuple[int, int, int, int] | None = None) -> list[tuple]:
-        """`_planes` with byte values: rint((v - lo) * scale) clipped to 0..qmax, 0 where not ok."""
-        return [(np.where(o[..., None], np.clip(np.rint((v - self._lo) * self._scale), 0, self._qmax), 0)
-                 .astype(np.uint8), o, size, step)
-                for v, o, size, step in _planes(level, ok, coarse, self._params.neighbourhood, box)]
 
-    def _exemplar_level(self, pyr: list, l: int, levels: int) -> _ExemplarLevel:
-        """Quantised neighbourhoods of all exemplar windows complete on level l (and the coarser one)."""
-        values, weight = pyr[l]
-        valid = weight >= 1 - 1e-6  # the whole blur footprint was exemplar
-        coarse = (pyr[l + 1][0], pyr[l + 1][1] >= 1 - 1e-6) if l + 1 < levels else None
-        planes = self._quantised_planes(values, valid, coarse)
-        pos = np.stack(np.nonzero(_complete(planes)), axis=1)
-        d = sum(size * size for _, _, size, _ in planes) * values.shape[2]
-        vec = np.empty((len(pos), d), np.uint8)
-        views = _value_windows(planes)
-        rows = max(1, _CHUNK // d)
-        for s in range(0, len(pos), rows):
-            vec[s:s + rows] = _take_windows(views, pos[s:s + rows, 0], pos[s:s + rows, 1])
-        index = np.full(valid.shape, -1, np.int64)
-        index[pos[:, 0], pos[:, 1]] = np.arange(len(pos))
-        return _ExemplarLevel(values.astype(np.float32), valid, pos, index, vec,
-                              np.einsum("nd,nd->n", vec, vec, dtype=np.float32))
+def _exemplar_source(image: np.ndarray, known: np.ndarray, hole: np.ndarray, max_exemplar: int,
+                     exemplar: np.ndarray | None, exemplar_valid: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    """The exemplar image and its valid pixels: `exemplar` where `exemplar_valid`, else the known
+    pixels of `image`; either cut to the `max_exemplar` pixels nearest the hole (or the centre)."""
+    if exemplar is None:
+        if not known.any():
+            raise DimredError("nothing is known around the hole: there is no exemplar to synthesise from")
+        return image, known & _nearest_pixels(known, hole, max_exemplar)
+    ex_image, ex_valid = _check_exemplar(exemplar, exemplar_valid, image.shape[2])
+    centre = np.zeros(ex_valid.shape, bool)
+    centre[ex_valid.shape[0] // 2, ex_valid.shape[1] // 2] = True
+    return ex_image, ex_valid & _nearest_pixels(ex_valid, centre, max_exemplar)
+
+
+@dataclass(frozen=True)
+class _Quantiser:
+    """Neighbourhood values as bytes: rint((v - lo) * scale) clipped to 0..qmax, with qmax small
+    enough that every squared distance between two neighbourhoods is an exact float32 integer."""
+
+    lo: float
+    scale: float
+    qmax: int
+    neighbourhood: int
+
+    @classmethod
+    def spanning(cls, values: np.ndarray, neighbourhood: int, channels: int) -> _Quantiser:
+        """The quantiser that maps the range of `values` (the valid exemplar's) onto 0..qmax."""
+        lo, hi = float(values.min()), float(values.max())
+        qmax = min(255, int(np.sqrt(_EXACT / ((neighbourhood * neighbourhood + 9) * channels))))
+        return cls(lo, qmax / (hi - lo) if hi > lo else 1.0, qmax, neighbourhood)
+
+    def planes(self, level: np.ndarray, ok: np.ndarray, coarse: tuple | None,
+               box: tuple[int, int, int, int] | None = None) -> list[tuple]:
+        """`_planes` with byte values, 0 where not ok."""
+        return [(np.where(o[..., None], np.clip(np.rint((v - self.lo) * self.scale), 0, self.qmax), 0)
+                 .astype(np.uint8), o, size, step)
+                for v, o, size, step in _planes(level, ok, coarse, self.neighbourhood, box)]
+
+
+def _exemplar_levels(ex_pyr: list, params: SynthesisParams, quantiser: _Quantiser) -> list[_ExemplarLevel]:
+    """The exemplar's levels, finest first. Automatic levels (params.levels 0) drop the coarsest
+    while it has fewer than MIN_WINDOWS complete windows; DimredError when a level still has."""
+    levels = len(ex_pyr)
+    while True:
+        coarsest = _exemplar_level(ex_pyr, levels - 1, levels, quantiser)
+        if len(coarsest.pos) >= MIN_WINDOWS or params.levels or levels == 1:
+            break
+        levels -= 1
+    exemplars = [_exemplar_level(ex_pyr, l, levels, quantiser) for l in range(levels - 1)] + [coarsest]
+    n = params.neighbourhood
+    for l, ex in enumerate(exemplars):
+        if len(ex.pos) < MIN_WINDOWS:
+            raise DimredError(
+                f"the exemplar has only {len(ex.pos)} complete {n}x{n} neighbourhoods on pyramid level {l} "
+                f"(at least {MIN_WINDOWS} needed): give a larger exemplar region, fewer levels or a smaller "
+                "neighbourhood"
+            )
+    return exemplars
+
+
+def _exemplar_level(pyr: list, l: int, levels: int, quantiser: _Quantiser) -> _ExemplarLevel:
+    """Quantised neighbourhoods of all exemplar windows complete on level l (and the coarser one)."""
+    values, weight = pyr[l]
+    valid = weight >= 1 - 1e-6  # the whole blur footprint was exemplar
+    coarse = (pyr[l + 1][0], pyr[l + 1][1] >= 1 - 1e-6) if l + 1 < levels else None
+    planes = quantiser.planes(values, valid, coarse)
+    pos = np.stack(np.nonzero(_complete(planes)), axis=1)
+    d = sum(size * size for _, _, size, _ in planes) * values.shape[2]
+    vec = np.empty((len(pos), d), np.uint8)
+    views = _value_windows(planes)
+    rows = max(1, _CHUNK // d)
+    for s in range(0, len(pos), rows):
+        vec[s:s + rows] = _take_windows(views, pos[s:s + rows, 0], pos[s:s + rows, 1])
+    index = np.full(valid.shape, -1, np.int64)
+    index[pos[:, 0], pos[:, 1]] = np.arange(len(pos))
+    return _ExemplarLevel(values.astype(np.float32), valid, pos, index, vec,
+                          np.einsum("nd,nd->n", vec, vec, dtype=np.float32))
+
+
+def _border_mismatch(ex: _ExemplarLevel, img: np.ndarray, src: np.ndarray, known: np.ndarray,
+                     border: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per known pixel next to the hole: its value in `img` minus what the copies (`src`) of its
+    hole neighbours on the `border` hold at its place (averaged over them), and which pixels have one."""
+    total, count = np.zeros(img.shape, np.float32), np.zeros(img.shape[:2], np.float32)
+    ys, xs = np.nonzero(border)
+    origin = ex.pos[src[ys, xs]]
+    for dy, dx in _STEPS4:
+        copy, ok = _sample(ex.values, ex.valid, origin[:, 0] + dy, origin[:, 1] + dx)
+        qy, qx = ys + dy, xs + dx
+        ok &= _lookup(known.astype(np.int8), qy, qx) > 0
+        total[qy[ok], qx[ok]] += img[qy[ok], qx[ok]] - copy[ok]  # one hole neighbour per direction
+        count[qy[ok], qx[ok]] += 1
+    return total / np.maximum(count, 1)[..., None], (count > 0).astype(np.float32)
+
+
+def _find_offsets(holes: list[np.ndarray], known: list[np.ndarray], known_pyr: list, ex_pyr: list,
+                  exemplars: list[_ExemplarLevel], params: SynthesisParams) -> list[np.ndarray]:
+    """Per level, the (K, 2) offsets t under which the known ring around the hole best matches
+    the exemplar at ring + t. A pool of shifts is ranked on the coarsest level over all shifts
+    (by FFT), refined by -1..1 and halved on every finer level, and cut to the K best on the
+    finest level, where the ring shows the most detail. Row k is one offset on all levels."""
+    levels = len(holes)
+    top = levels - 1
+    rings = [_dilate(h, params.neighbourhood // 2 + 1) & k for h, k in zip(holes, known, strict=True)]
+    valid = [w >= 1 - 1e-6 for _, w in ex_pyr]
+    offsets = [None] * levels
+    offsets[top] = _rank_offsets(known_pyr[top][0], rings[top], holes[top], ex_pyr[top][0], valid[top],
+                                 exemplars[top].index >= 0, _OFFSET_POOL)
+    keep = np.arange(len(offsets[top]))
+    for l in range(top - 1, -1, -1):
+        # halve the pool on each level, the finer levels judging the fewer, better shifts
+        t, score = _refine_offsets(2 * offsets[l + 1][keep], known_pyr[l][0], rings[l], ex_pyr[l][0], valid[l])
+        offsets[l] = np.zeros_like(offsets[top])
+        offsets[l][keep] = t
+        keep = keep[np.argsort(score, kind="stable")[:max(params.offsets, len(keep) // 2)]]
+    return [t[keep[:params.offsets]] for t in offsets]
 
 
 @dataclass
@@ -792,8 +832,9 @@ def _check_inputs(image, known, hole, params: SynthesisParams):
         raise DimredError(f"synthesis wants an (H, W, C) image and (H, W) masks, got {image.shape}, "
                           f"{known.shape}, {hole.shape}")
     n = params.neighbourhood
-    if (n < 1 or n % 2 == 0 or min(params.generations, params.finest_generations, params.random_candidates) < 1 or params.levels < 0
-            or params.offsets < 0 or params.max_exemplar < MIN_WINDOWS):
+    passes = min(params.generations, params.finest_generations, params.random_candidates)
+    if (n < 1 or n % 2 == 0 or passes < 1 or params.levels < 0 or params.offsets < 0
+            or params.max_exemplar < MIN_WINDOWS):
         raise DimredError(f"bad synthesis parameters {params}: the neighbourhood must be odd, generations and "
                           f"random candidates at least 1, levels and offsets not negative, max_exemplar at least "
                           f"{MIN_WINDOWS}")

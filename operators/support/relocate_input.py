@@ -64,7 +64,7 @@ class RelocateInput:
     refusal: str = ""  # why the place the values lead to breaks the constraint (the operator checks it)
 
     @classmethod
-    def starting_at(cls, yaw: float, distance_scale: float, mouse: tuple[int, int] | None = None) -> "RelocateInput":
+    def starting_at(cls, yaw: float, distance_scale: float, *, mouse: tuple[int, int] | None = None) -> RelocateInput:
         """A tool whose mouse values start at a move already set (the panel's fields)."""
         return cls(yaw_mouse=yaw, log_scale_mouse=math.log(distance_scale) if distance_scale > 0 else 0.0,
                    mouse=mouse)

@@ -41,7 +41,7 @@ PREVIEW_IMAGE = "DimRed Preview"
 # Seconds a cancelled worker may take to notice; the engine checks far more often than this.
 STOP_TIMEOUT = 5.0
 
-_running: list["RemovalSession"] = []
+_running: list[RemovalSession] = []
 
 
 def output_folder(settings: bpy.types.PropertyGroup) -> str:
@@ -65,7 +65,7 @@ def own_filename(world: bpy.types.World, object_name: str) -> str:
 
 
 def probe_center(settings: bpy.types.PropertyGroup) -> tuple[float, float, float] | None:
-    # None lets the bridge apply the contract's fallbacks (an Empty named ProbeCenter, the origin).
+    # None lets the reader apply the contract's fallbacks (an Empty named ProbeCenter, the origin).
     return tuple(settings.probe_center) if settings.use_probe_center else None
 
 
@@ -94,23 +94,23 @@ def _earlier(settings: bpy.types.PropertyGroup, target: str) -> list:
     return [r for r in settings.removals if r.object_name != target and r.image is not None]
 
 
-def engine_scene(scene: bpy.types.Scene, target: str, photographed: Matrix | None = None) -> "SceneData":
+def engine_scene(scene: bpy.types.Scene, target: str, photographed: Matrix | None = None) -> SceneData:
     """The scene as the engine must see it for a run on `target`: earlier removed objects gone
     from the room, relocated ones at their new place, and `target` where the panorama shows it
     (`photographed`, by default `photographed_matrix`: also when an earlier relocation of it
     has moved it since); the panorama's pixels deferred."""
-    from ...addon.blender import reader as bridge
+    from ...addon.blender import reader
 
     settings = scene.dimred
     removed = [r.object_name for r in _earlier(settings, target) if r.kind == 'REMOVE']
-    scene_data = bridge.read_scene(scene, probe_center(settings), defer_file=True, exclude=removed)
+    scene_data = reader.read_scene(scene, center=probe_center(settings), defer_file=True, exclude=removed)
     obj = scene.objects[target]
     if photographed is None:
         photographed = photographed_matrix(settings, obj)
     return _placed(scene_data, target, to_photographed(obj, photographed))
 
 
-def active() -> "RemovalSession | None":
+def active() -> RemovalSession | None:
     """The session that is computing now, if any."""
     return next((s for s in _running if s.worker is not None and not s.done), None)
 
@@ -145,7 +145,7 @@ class RemovalSession:
     scene_name: str
     world_name: str
     object_name: str
-    request: "RemovalRequest"
+    request: RemovalRequest
     pack: bool
     relative: bool  # the output folder is given relative to the .blend
     photographed: Matrix  # the object's world matrix where the panorama shows it
@@ -162,14 +162,14 @@ class RemovalSession:
 
     # -- main thread: gather ------------------------------------------------------------
     @classmethod
-    def begin(cls, context: bpy.types.Context, move: "Move | None" = None,
-              photographed: Matrix | None = None) -> "RemovalSession":
+    def begin(cls, context: bpy.types.Context, move: Move | None = None,
+              photographed: Matrix | None = None) -> RemovalSession:
         """Check the input and read the scene; DimredError says what is wrong (nothing changed).
 
         With `move`, the run relocates the marked object instead of removing it, from
         `photographed` (its world matrix where the panorama shows it; by default
         `photographed_matrix`)."""
-        from ...addon.blender import reader as bridge
+        from ...addon.blender import reader
         from ...addon.relocation.fixedview import check_move
         from ...addon.run.job import RemovalRequest
 
@@ -190,10 +190,10 @@ class RemovalSession:
         if pack:
             folder = tempfile.mkdtemp(prefix="dimred-")
         try:
-            bridge.check_object(scene, target)
+            reader.check_object(scene, target)
             names = settings.surface_names()
             for name in names:
-                bridge.check_object(scene, name, purpose="used as a target surface")
+                reader.check_object(scene, name, purpose="used as a target surface")
             earlier = _earlier(settings, target)
             if photographed is None:
                 photographed = photographed_matrix(settings, scene.objects[target])
@@ -212,8 +212,8 @@ class RemovalSession:
         previous = world_layer.layer_image(world) if world_layer.has_layer(world) else None
         index = _index(settings, target)
         later = [r.object_name for r in settings.removals[index + 1:]] if index >= 0 else []
-        warnings = [f"'{', '.join(later)}' were removed after '{target}' with it still in place: "
-                    "remove them again for the most accurate result"] if later else []
+        warnings = [(f"'{', '.join(later)}' were removed after '{target}' with it still in place: "
+                     "remove them again for the most accurate result")] if later else []
         return cls(scene_name=scene.name, world_name=world.name, object_name=target, request=request, pack=pack,
                    relative=settings.output_dir.strip().startswith("//") and not pack, photographed=photographed,
                    temporary_folder=folder if pack else "",
@@ -235,7 +235,7 @@ class RemovalSession:
         from ...addon.run.job import run
 
         request = self.request
-        self.worker = Worker(lambda progress, cancelled, preview: run(request, progress, cancelled, preview)).start()
+        self.worker = Worker(lambda callbacks: run(request, callbacks)).start()
         _running.append(self)
 
     def tick(self, context: bpy.types.Context) -> str:
@@ -250,7 +250,7 @@ class RemovalSession:
                 return 'RUNNING'
             self.done = True
             self._forget()
-            if isinstance(update.error, DimredError):
+            if isinstance(update.error, (DimredError, Cancelled)):
                 self._fail(context, str(update.error))
             elif update.error is not None:
                 self._fail(context, f"The {self.verb} failed: {type(update.error).__name__}: {update.error}")
@@ -301,7 +301,7 @@ class RemovalSession:
         world.update_tag()
         _redraw(context)
 
-    def _apply(self, context: bpy.types.Context, outcome: "RemovalOutcome") -> bool:
+    def _apply(self, context: bpy.types.Context, outcome: RemovalOutcome) -> bool:
         world = self._world()
         scene = bpy.data.scenes.get(self.scene_name)
         if world is None or scene is None:
@@ -392,7 +392,7 @@ def move_summary(relocation: dict) -> str:
             f"view elevation {relocation['elevation_change']:+.1f}°")
 
 
-def _placed(scene: "SceneData", name: str, transform: np.ndarray | None) -> "SceneData":
+def _placed(scene: SceneData, name: str, transform: np.ndarray | None) -> SceneData:
     """`scene` with the triangles of object `name` moved by the (4, 4) world `transform`."""
     from ...addon.relocation.fixedview import apply
 

@@ -1,0 +1,56 @@
+"""Irradiance before and after the removal at receivers: the coarse ones, or the vertices of a
+fine lattice laid over the triangles where points need it."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..callbacks import RunCallbacks
+from ..geometry.mesh import Geometry
+from ..geometry.patches import build_lattice, levels_for_size
+from ..light.split import Split
+from .interpolation import inset
+from .occlusion import Occlusion
+from .room import Room
+from .target import Target
+
+
+def before_and_after(room: Room, db: np.ndarray, split: Split, t: np.ndarray, t_w: np.ndarray,
+                     ts: np.ndarray, ts_w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(E, E') at receivers with transport t, t_w from the patches and ts, ts_w from the split
+    patches' sub-triangles (with and without the object): the room as photographed, and after
+    removal with every bounce of the change db (P, 3)."""
+    rest = split.rest(room.senders.radiosity)
+    return t @ rest + ts @ split.b, t_w @ (rest + db) + ts_w @ (split.b + split.db)
+
+
+@dataclass(frozen=True)
+class FineLight:
+    """Transport and irradiance at the vertices of a fine lattice, and where points find them."""
+
+    t_with: np.ndarray  # (V, P) transport from the patches with the object
+    t_without: np.ndarray  # (V, P) ... without it
+    e: np.ndarray  # (V, 3) E as photographed
+    e_after: np.ndarray  # (V, 3) E' after removal
+    corners: np.ndarray  # (N, 3) rows of the vertices each point interpolates
+    weights: np.ndarray  # (N, 3) their weights
+
+
+def fine_light(geo: Geometry, target: Target, room: Room, occlusion: Occlusion, db: np.ndarray, split: Split,
+               tri: np.ndarray, bary: np.ndarray, callbacks: RunCallbacks) -> FineLight:
+    """Light at the vertices of a fine lattice (cells of about the target's `fine_cell`) over
+    the triangles `tri`: only the vertices that the points (tri, bary) interpolate from."""
+    tris_r = np.unique(tri)
+    levels = np.zeros(len(geo.triangles), dtype=np.int64)
+    levels[tris_r] = levels_for_size(geo.triangles[tris_r], target.fine_cell, max_level=512)
+    fine = build_lattice(geo.triangles, levels)
+    _, corners, weights = fine.locate(tri, bary)
+    needed, inverse = np.unique(corners, return_inverse=True)
+    callbacks.check()
+    points = inset(fine.vertices[needed], geo.triangles[fine.vertex_tri[needed]])
+    normals = geo.normals[fine.vertex_tri[needed]]
+    t_with, t_without = occlusion.transport(points, normals, room.senders, callbacks)
+    e, e_after = before_and_after(room, db, split, t_with, t_without,
+                                  *occlusion.transport(points, normals, split.senders, callbacks))
+    return FineLight(t_with, t_without, e, e_after, inverse.reshape(corners.shape), weights)

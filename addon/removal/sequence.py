@@ -1,0 +1,121 @@
+"""The removal as a sequence of stages, each a function of the previous stages' frozen results:
+
+    geo, target = prepare(...)          the scene in the probe frame, the object to remove
+    traced = trace(...)                 what every pixel sees, with the object and without it
+    solution = solve_lighting(...)      occluders, room, first order, propagation, local light
+    result = finish(...)                the ratio form where surfaces stay, the fill where it hid
+
+`solve` runs the first three; a relocation runs them itself to insert its first guess of the
+panorama between the trace and the light.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..callbacks import NO_CALLBACKS, RunCallbacks
+from ..geometry.mesh import Geometry
+from ..quality import Params
+from ..report import Report
+from ..scene import SceneData
+from .compose import compose
+from .fill import fill_hidden
+from .first_order import first_order
+from .local import local_light
+from .occlusion import occluders
+from .propagation import propagate_change
+from .room import solve_room
+from .solution import Solution
+from .target import Target, prepare
+from .trace import Traced, trace
+
+STAGES = 8  # the stages a removal reports progress for
+
+
+@dataclass(frozen=True)
+class RemovalResult:
+    difference: np.ndarray  # (H, W, 3) float32, top row first
+    edited: np.ndarray  # (H, W, 3) float32: hdri + difference
+    hidden_mask: np.ndarray  # (H, W) bool: pixels that showed the object
+    report: dict
+
+
+def traced_scene(scene: SceneData, object_name: str, planes: list[str] | tuple[str, ...], params: Params,
+                 rep: Report, callbacks: RunCallbacks, *, fill: bool = True) -> tuple[Geometry, Target, Traced]:
+    """The geometry, the target and what the pixels see. Without `fill` (an insertion has
+    nothing to fill) the pixels around the object are relit like the rest."""
+    geo, target = prepare(scene, object_name, planes, params, rep)
+    height, width = scene.hdri.shape[:2]
+    with rep.stage("trace"):
+        traced = trace(geo, target, width, height, fill=fill, rep=rep)
+    callbacks.check()
+    return geo, target, traced
+
+
+def solve_lighting(hdri: np.ndarray, geo: Geometry, target: Target, traced: Traced, params: Params, rep: Report,
+                   callbacks: RunCallbacks) -> Solution:
+    """The light before and after the removal at every hit pixel, the room's radiosity read
+    from `hdri`; the stages are timed in `rep`."""
+    with rep.stage("occluders"):
+        occlusion = occluders(geo, target, traced, rep)
+    with rep.stage("radiosity"):
+        room = solve_room(hdri, geo, target, traced, occlusion, params, rep, callbacks)
+    callbacks.check()
+    with rep.stage("first_order"):
+        first = first_order(room, target, occlusion, params, rep, callbacks)
+    with rep.stage("propagation"):
+        propagation = propagate_change(first, occlusion, params, rep, callbacks)
+    callbacks.check()
+    with rep.stage("local"):
+        local = local_light(geo, target, traced, occlusion, first.room, propagation, params, rep, callbacks)
+    return Solution(hdri=hdri, params=params, geo=geo, target=target, traced=traced, occlusion=occlusion,
+                    room=first.room, db=propagation.db, split=propagation.split, e_h=local.e_h, de_h=local.de_h)
+
+
+def solve(scene: SceneData, object_name: str, planes: list[str] | tuple[str, ...], params: Params, rep: Report,
+          callbacks: RunCallbacks = NO_CALLBACKS, *, fill: bool = True) -> Solution:
+    """Every stage of the removal up to the new irradiance of each pixel."""
+    geo, target, traced = traced_scene(scene, object_name, planes, params, rep, callbacks, fill=fill)
+    return solve_lighting(scene.hdri, geo, target, traced, params, rep, callbacks)
+
+
+def finish(solution: Solution, rep: Report, callbacks: RunCallbacks = NO_CALLBACKS) -> RemovalResult:
+    """The edited panorama from a solved removal: the ratio form on the pixels that keep their
+    surface, texture synthesis where the object was. `callbacks.preview` gets difference
+    images as the fill refines."""
+    traced = solution.traced
+    revealed = traced.behind.revealed
+    with rep.stage("compose"):
+        d_h = compose(solution, rep)
+
+    def difference_image(d_revealed: np.ndarray) -> np.ndarray:
+        d = d_h.copy()
+        d[revealed] = d_revealed
+        image = np.zeros((traced.height * traced.width, 3), dtype=np.float32)
+        image[traced.hp] = d
+        return image.reshape(traced.height, traced.width, 3)
+
+    if len(revealed):
+        show = None if callbacks.preview is None else lambda d_revealed: callbacks.show(difference_image(d_revealed))
+        with rep.stage("synthesis"):
+            d_revealed = fill_hidden(solution, rep, callbacks, show)
+    else:
+        d_revealed = np.zeros((0, 3))
+        rep.skip("synthesis", "the object is not visible from the probe centre: no hidden region to fill"
+                 if not traced.hidden_h.any() else "nothing is behind the object to fill")
+    difference = difference_image(d_revealed)
+    edited = (solution.hdri + difference).astype(np.float32)
+    rep.info["hidden_region_filled"] = bool(len(revealed) == traced.hidden_h.sum())
+    return RemovalResult(difference=difference, edited=edited, hidden_mask=traced.hidden_map, report=rep.as_dict())
+
+
+def remove(scene: SceneData, object_name: str, *, planes: list[str] | tuple[str, ...] = (),
+           params: Params | None = None, callbacks: RunCallbacks = NO_CALLBACKS) -> RemovalResult:
+    """Remove `object_name`'s shadows and reflected light from the scene's panorama.
+
+    `callbacks.preview(difference)` gets (H, W, 3) float32 difference images before the
+    result: the lighting corrected with the hidden region roughly filled, then refined level
+    by level."""
+    rep = Report(callbacks.progress, stages=STAGES)
+    return finish(solve(scene, object_name, planes, params or Params(), rep, callbacks), rep, callbacks)

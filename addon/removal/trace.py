@@ -1,0 +1,99 @@
+"""What each panorama pixel sees from the probe centre, with the object and without it."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..geometry import latlong
+from ..geometry.mesh import Geometry
+from ..geometry.raycast import PanoramaHits, trace_panorama
+from ..report import Report
+from .target import Target
+
+
+@dataclass(frozen=True)
+class Behind:
+    """What the probe would see where the object was: per panorama pixel (flat, H*W) and per
+    revealed pixel (the hidden pixels that see a surface once the object is gone)."""
+
+    tri_without: np.ndarray  # (H*W,) first triangle hit without the object, -1 for none
+    distance_without: np.ndarray  # (H*W,) its distance (0 where nothing is traced)
+    revealed: np.ndarray  # (K,) rows of the hit pixels (the `_h` arrays) that are revealed
+    tri: np.ndarray  # (K,) triangle each revealed pixel sees
+    bary: np.ndarray  # (K, 2) barycentric weights of vertices 1 and 2 there
+    points: np.ndarray  # (K, 3) the point it sees
+
+    @classmethod
+    def nothing(cls, pixels: int) -> Behind:
+        return cls(np.full(pixels, -1, dtype=np.int64), np.zeros(pixels), np.zeros(0, dtype=np.int64),
+                   np.zeros(0, dtype=np.int64), np.zeros((0, 2)), np.zeros((0, 3)))
+
+
+@dataclass(frozen=True)
+class Traced:
+    """The first hit of every pixel's ray; the `_h` arrays hold one row per hit pixel."""
+
+    hits: PanoramaHits
+    width: int
+    height: int
+    hp: np.ndarray  # (N,) flat panorama index of each hit pixel
+    tri_h: np.ndarray  # (N,) triangle it sees
+    obj_h: np.ndarray  # (N,) object it sees
+    points_h: np.ndarray  # (N, 3) the point it sees, probe frame
+    normals_h: np.ndarray  # (N, 3) the normal there
+    hidden_h: np.ndarray  # (N,) bool: filled rather than relit (the object and its silhouette)
+    hidden_map: np.ndarray  # (H, W) bool: the same per panorama pixel
+    behind: Behind
+
+    def panorama_rows(self, image: np.ndarray) -> np.ndarray:
+        """(N, 3) float64 values of an (H, W, 3) image at the hit pixels."""
+        return image.reshape(-1, 3)[self.hp].astype(np.float64)
+
+
+def trace(geo: Geometry, target: Target, width: int, height: int, *, fill: bool, rep: Report) -> Traced:
+    """What each pixel sees. With `fill` (a removal), the pixels around the object count as
+    hidden too (they are filled, not relit), and what is behind the hidden ones is traced."""
+    hits = trace_panorama(geo.triangles, width, height)
+    flat_tri = hits.tri.ravel()
+    hp = np.flatnonzero(flat_tri >= 0)
+    tri_h = flat_tri[hp]
+    obj_h = geo.tri_object[tri_h]
+    # A pixel on the object's silhouette mixes it with what is behind; the ratio form would
+    # scale the object's share of it too, so it is filled like the pixels the object covers.
+    on_object = np.zeros(height * width, dtype=bool)
+    on_object[hp[obj_h == target.index]] = True
+    hidden = on_object.reshape(height, width)
+    if fill:
+        hidden = latlong.dilate(hidden, 1)
+    hidden_h = hidden.ravel()[hp]
+    hidden_map = np.zeros(height * width, dtype=bool)
+    hidden_map[hp[hidden_h]] = True
+    missing = len(flat_tri) - len(hp)
+    if missing:
+        rep.warn(f"{missing} panorama pixels see no proxy geometry (open room?); they are left unchanged")
+    rep.info["hidden_pixels"] = int(hidden_h.sum())
+    behind = Behind.nothing(height * width)
+    if fill and hidden_h.any():
+        behind = _behind(geo, target, width, height, hp, hidden_h, rep)
+    return Traced(hits=hits, width=width, height=height, hp=hp, tri_h=tri_h, obj_h=obj_h,
+                  points_h=hits.points.reshape(-1, 3)[hp], normals_h=geo.normals[tri_h], hidden_h=hidden_h,
+                  hidden_map=hidden_map.reshape(height, width), behind=behind)
+
+
+def _behind(geo: Geometry, target: Target, width: int, height: int, hp: np.ndarray, hidden_h: np.ndarray,
+            rep: Report) -> Behind:
+    """The surfaces to fill: what the hidden pixels see once the object is gone."""
+    keep = np.flatnonzero(geo.tri_object != target.index)
+    hits = trace_panorama(geo.triangles[keep], width, height)
+    flat = hits.tri.ravel()
+    tri_without = np.full(height * width, -1, dtype=np.int64)
+    tri_without[flat >= 0] = keep[flat[flat >= 0]]
+    hidden = np.flatnonzero(hidden_h)
+    revealed = hidden[tri_without[hp[hidden]] >= 0]
+    pix = hp[revealed]
+    unseen = len(hidden) - len(revealed)
+    if unseen:
+        rep.warn(f"{unseen} pixels of the object see no proxy geometry behind it; they are left unchanged")
+    return Behind(tri_without=tri_without, distance_without=hits.distance.ravel(), revealed=revealed,
+                  tri=tri_without[pix], bary=hits.bary.reshape(-1, 2)[pix], points=hits.points.reshape(-1, 3)[pix])

@@ -1,0 +1,56 @@
+"""Filling the floor a lid hides: reflectance synthesised on the plane raster, not blurred."""
+import numpy as np
+
+from addon.geometry import latlong
+from addon.synthesis.plane_fill import FillOptions, HiddenPlane, PanoramaMaps, PanoramaReflectance, fill_surface
+from addon.synthesis.texture import SynthesisParams
+from tests.engine.geometry.test_planeraster import maps
+
+WIDTH = 512
+
+
+def checker_rho(points, period=0.2):
+    """Reflectance of a floor checker of 0.1 m squares: 0.7 and 0.2 in every channel."""
+    k = (np.floor(points[..., 0] / (period / 2)) + np.floor(points[..., 1] / (period / 2))) % 2
+    return np.where(k[..., None] == 0, 0.7, 0.2) * np.ones(3)
+
+
+def setup():
+    s_with, d_with, s_without, d_without, hidden = maps(WIDTH)
+    panorama_maps = PanoramaMaps(s_with, d_with, s_without, d_without, hidden)
+    points = latlong.pixel_directions(WIDTH, WIDTH // 2) * d_without[..., None]
+    rho = checker_rho(points)
+    valid = (s_with == 0) & ~hidden
+    revealed = hidden & (s_without == 0)
+    floor = HiddenPlane(surface=0, normal=np.array([0, 0, 1.0]), points=points[revealed])
+    return panorama_maps, rho, valid, floor, checker_rho(points[revealed])
+
+
+def _options(seed: int = 0) -> FillOptions:
+    return FillOptions(cell=0.02, margin=1.5, synthesis=SynthesisParams(), seed=seed)
+
+
+def test_the_fill_continues_the_checker_under_the_lid():
+    panorama_maps, rho, valid, floor, truth = setup()
+    got = fill_surface(PanoramaReflectance(rho, valid, panorama_maps), floor, _options())
+    points = floor.points
+    assert got.synthesised and got.known_cells > 1000 and got.hole_cells >= len(points) // 4
+    assert np.isfinite(got.rho).all() and (got.rho >= 0).all()
+    y = got.rho[:, 0]
+    # Texture, not a blur: most values are near one of the two reflectances, both present.
+    assert np.mean((np.abs(y - 0.7) < 0.15) | (np.abs(y - 0.2) < 0.15)) > 0.7
+    assert 0.25 < np.mean(y > 0.45) < 0.75
+    assert abs(y.mean() - truth[:, 0].mean()) < 0.12
+
+
+def test_the_same_seed_fills_the_same_and_the_mean_stands_in_for_a_tiny_exemplar():
+    panorama_maps, rho, valid, floor, _ = setup()
+    panorama = PanoramaReflectance(rho, valid, panorama_maps)
+    a, b = fill_surface(panorama, floor, _options(seed=3)), fill_surface(panorama, floor, _options(seed=3))
+    assert np.array_equal(a.rho, b.rho)
+    # With all but a handful of floor pixels invalid, there is nothing to learn the texture from.
+    few = np.zeros_like(valid)
+    few[np.argwhere(valid)[:10].T.tolist()] = True
+    c = fill_surface(PanoramaReflectance(rho, few, panorama_maps), floor, _options())
+    assert not c.synthesised
+    assert np.allclose(c.rho, c.rho[0]) and np.isfinite(c.rho).all()

@@ -1,0 +1,211 @@
+"""The ground-truth harness: specs, the built scenes, tiny cached render pairs, and the
+panorama convention (camera, formula and the world's Environment Texture agree)."""
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from scenes import metrics as M
+from scenes import spec as S
+from scenes.images import read_exr
+from scenes.render import REPO, load_pair, render_pair, render_world
+
+# 70 degrees of world rotation is exactly 14 columns at this width, so the rotated and the
+# plain panoramas are whole-pixel shifts of each other and can be compared bit for bit.
+W, H = 72, 36
+# Few bounces: these tests check the harness (files, seeding, masks), not the light transport.
+TINY = {"width": W, "height": H, "samples": 16, "max_bounces": 8}
+
+
+def _py(code: str) -> str:
+    """Run `code` in a fresh interpreter (bpy state never enters pytest); return its stdout."""
+    proc = subprocess.run([sys.executable, "-c", code], cwd=REPO, capture_output=True,
+                          text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    return proc.stdout
+
+
+@pytest.fixture(scope="module")
+def basic() -> S.SceneSpec:
+    return S.get("basic_box").with_render(**TINY)
+
+
+@pytest.fixture(scope="module")
+def rotated() -> S.SceneSpec:
+    return S.get("rotated_world").with_render(**TINY)
+
+
+# --- specs (no rendering) -------------------------------------------------------------------
+
+def test_spec_json_round_trip_and_key() -> None:
+    for spec in S.SPECS.values():
+        again = S.SceneSpec.from_json(spec.to_json())
+        assert again == spec and again.key() == spec.key()
+    base = S.get("basic_box")
+    assert base.with_render(samples=5).key() != base.key()
+    assert S.get("rotated_world").key() != base.key()
+    assert len({s.key() for s in S.SPECS.values()}) == len(S.SPECS)
+
+
+def test_spec_validation() -> None:
+    base = S.get("basic_box")
+    with pytest.raises(ValueError, match="remove"):
+        S.SceneSpec(**{**base.__dict__, "remove": "Nothing"})
+    with pytest.raises(ValueError, match="probe"):
+        S.SceneSpec(**{**base.__dict__, "probe": (10.0, 0.0, 1.5)})
+    with pytest.raises(ValueError, match="used by the room"):
+        floor = S.SceneObject("Floor", "box", (1.0, 1.0, 1.0), (0.0, 0.0, 0.0))
+        S.SceneSpec(**{**base.__dict__, "objects": (floor,), "remove": "Floor"})
+    with pytest.raises(KeyError, match="known"):
+        S.get("no_such_scene")
+
+
+def test_named_specs_are_varied() -> None:
+    assert {"basic_box", "red_box", "stool", "wall_contact", "bright_lamp", "seam", "nadir",
+            "rotated_world", "second_object", "demo"} <= set(S.SPECS)
+    assert {s.room.floor.pattern for s in S.SPECS.values()} == set(S.FLOOR_PATTERNS)
+    assert {o.kind for s in S.SPECS.values() for o in s.objects} == set(S.OBJECT_KINDS)
+    strengths = [lamp.strength for lamp in S.get("bright_lamp").lamps]
+    assert max(strengths) >= 1000 * min(strengths)
+
+
+@pytest.mark.slow
+def test_every_named_spec_builds() -> None:
+    out = _py(
+        "import json, bpy\n"
+        "from scenes import spec, build\n"
+        "res = {}\n"
+        "for name, s in spec.SPECS.items():\n"
+        "    bpy.ops.wm.read_factory_settings(use_empty=True)\n"
+        "    build.build(s)\n"
+        "    res[name] = sorted(o.name for o in bpy.context.scene.objects)\n"
+        "print(json.dumps(res))\n")
+    built = json.loads(out.strip().splitlines()[-1])
+    for name, spec in S.SPECS.items():
+        names = set(built[name])
+        assert {"Floor", "Ceiling", "ProbeCenter", "ProbeCamera", "Wall.East", "Wall.West",
+                "Wall.North", "Wall.South"} <= names
+        assert {o.name for o in spec.objects} <= names
+        n = len(spec.lamps)
+        assert {f"Lamp.{i:03d}" for i in range(1, n + 1)} <= names
+        assert {f"LampHousing.{i:03d}" for i in range(1, n + 1)} <= names
+
+
+# --- a tiny render pair ---------------------------------------------------------------------
+
+@pytest.mark.slow
+def test_pair_files_and_linear_output(basic: S.SceneSpec) -> None:
+    paths = render_pair(basic)
+    assert all(p.exists() for p in paths.values())
+    assert paths["input"].parent.name == basic.key()
+    inp, truth, mask = load_pair(basic)
+    assert inp.shape == truth.shape == (H, W, 3) and inp.dtype == np.float32
+    assert mask.shape == (H, W) and mask.dtype == bool
+    # Pixels that see a lamp show its radiance exactly: no view transform, no clamping.
+    assert inp.max() == pytest.approx(max(lamp.strength for lamp in basic.lamps))
+    assert render_pair(basic) == paths  # cached
+
+
+@pytest.mark.slow
+def test_input_and_truth_differ_near_the_object_only(basic: S.SceneSpec) -> None:
+    inp, truth, mask = load_pair(basic)
+    yi, yt = M.luminance(inp), M.luminance(truth)
+    rel = np.abs(yi - yt) / yt
+    near, far = M.dilate(mask, 4) & ~mask, ~M.dilate(mask, 12)
+    assert rel[mask].mean() > 0.2
+    assert rel[near].mean() > 3 * rel[far].mean()
+    # Same seed: where no path touched the box the two renders are identical.
+    assert np.median(rel[far]) == 0.0
+    # The box's shadow: without it the floor around it is brighter.
+    assert (yt - yi)[near].sum() > 0
+
+
+def _pixel_of(direction: np.ndarray) -> tuple[float, float]:
+    """(row, column) of a direction with u = 0.5 - atan2(y, x) / 2pi, v = 1 - acos(z) / pi."""
+    x, y, z = direction / np.linalg.norm(direction)
+    u = 0.5 - math.atan2(y, x) / (2 * math.pi)
+    v = 1.0 - math.acos(z) / math.pi
+    return (1.0 - v) * H - 0.5, u * W - 0.5
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["basic_box", "seam", "nadir"])
+def test_mask_is_where_the_formula_puts_the_object(name: str) -> None:
+    scene = S.get(name).with_render(**TINY)
+    _, _, mask = load_pair(scene)
+    obj = scene.removed_object()
+    centre = np.array(obj.location) + np.array([0.0, 0.0, obj.size[2] / 2]) - np.array(scene.probe)
+    row, col = _pixel_of(centre)
+    assert mask[round(row), round(col) % W]
+    rows, cols = np.nonzero(mask)
+    # Columns are angles: average them on the circle so a region across the seam works.
+    angle = np.angle(np.exp(2j * np.pi * (cols + 0.5) / W).mean())
+    mean_col = (angle / (2 * np.pi) * W - 0.5) % W
+    assert abs(rows.mean() - row) < 1.0
+    assert abs((mean_col - col + W / 2) % W - W / 2) < 1.0
+    if name == "seam":
+        assert mask[:, 0].any() and mask[:, -1].any()
+
+
+@pytest.mark.slow
+def test_scene_blend_is_the_users_scene(basic: S.SceneSpec, rotated: S.SceneSpec) -> None:
+    code = (
+        "import json, sys, bpy\n"
+        "res = {}\n"
+        "for path in sys.argv[1:]:\n"
+        "    bpy.ops.wm.open_mainfile(filepath=path)\n"
+        "    sc = bpy.context.scene\n"
+        "    nodes = {n.bl_idname: n for n in sc.world.node_tree.nodes}\n"
+        "    env = nodes['ShaderNodeTexEnvironment']\n"
+        "    m = nodes.get('ShaderNodeMapping')\n"
+        "    res[path] = dict(\n"
+        "        image=bpy.path.abspath(env.image.filepath),\n"
+        "        space=env.image.colorspace_settings.name,\n"
+        "        interp=env.interpolation, size=list(env.image.size),\n"
+        "        feeds_bg=env.outputs['Color'].links[0].to_node.bl_idname,\n"
+        "        rot=list(m.inputs['Rotation'].default_value) if m else None,\n"
+        "        mtype=m.vector_type if m else None,\n"
+        "        coords=m.inputs['Vector'].links[0].from_socket.name if m else None,\n"
+        "        probe=list(sc.objects['ProbeCenter'].location),\n"
+        "        objects=sorted(o.name for o in sc.objects))\n"
+        "print(json.dumps(res))\n")
+    blends = [str(render_pair(s)["blend"]) for s in (basic, rotated)]
+    proc = subprocess.run([sys.executable, "-c", code, *blends], cwd=REPO, capture_output=True,
+                          text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    res = json.loads(proc.stdout.strip().splitlines()[-1])
+    for spec, blend in zip((basic, rotated), blends, strict=True):
+        r = res[blend]
+        assert Path(r["image"]).resolve() == render_pair(spec)["input"].resolve()
+        assert r["space"] in ("Linear Rec.709", "Non-Color") and r["interp"] == "Linear"
+        assert r["size"] == [W, H] and r["feeds_bg"] == "ShaderNodeBackground"
+        assert r["probe"] == pytest.approx(spec.probe)
+        assert spec.remove in r["objects"] and "Floor" in r["objects"]
+    assert res[blends[0]]["rot"] is None
+    assert res[blends[1]]["rot"] == pytest.approx([0.0, 0.0, math.radians(70.0)])
+    assert res[blends[1]]["mtype"] == "POINT" and res[blends[1]]["coords"] == "Generated"
+
+
+@pytest.mark.slow
+def test_world_reproduces_the_scene(basic: S.SceneSpec, rotated: S.SceneSpec,
+                                    tmp_path: Path) -> None:
+    """A user's panoramic camera at the probe centre sees, through the world's Environment
+    Texture (Closest) and Mapping node, exactly the panorama the pair was rendered as, with the
+    scene's geometry in the same pixels as in the unrotated scene."""
+    plain = render_pair(basic)
+    world = render_world(plain["blend"], tmp_path / "plain.exr")
+    assert np.array_equal(world, read_exr(plain["input"]))
+
+    turned = render_pair(rotated)
+    shift = round(rotated.world_rotation_z / 360.0 * W)
+    world = render_world(turned["blend"], tmp_path / "turned.exr")
+    assert np.array_equal(world, np.roll(read_exr(turned["input"]), shift, axis=1))
+    # The rotated panorama holds the same room shifted: geometry seen by the user's camera
+    # through the Mapping node lands where the plain scene has it.
+    assert np.array_equal(np.load(turned["mask"]), np.roll(np.load(plain["mask"]), -shift, axis=1))
