@@ -141,14 +141,25 @@ def boundary_objects(geometry: Geometry, witnesses: np.ndarray) -> np.ndarray:
             continue
         n = geometry.normals[sel]
         off = np.einsum("ij,ij->i", n, geometry.triangles[sel, 0])
-        ok = True
-        for i0 in range(0, len(witnesses), 20_000):
-            h = witnesses[i0 : i0 + 20_000] @ n.T - off
-            if (h < -tol).any():
-                ok = False
-                break
-        out[obj] = ok
+        out[obj] = _all_on_lit_side(witnesses, n, off, tol)
     return out
+
+
+_PRODUCT_ENTRIES = 1 << 22  # witness-plane heights computed at once (32 MB of float64)
+
+
+def _all_on_lit_side(witnesses: np.ndarray, normals: np.ndarray, offsets: np.ndarray, tol: float) -> bool:
+    """Whether every witness (W, 3) lies on the lit side of every plane (normals (N, 3), offsets
+    (N,)). A spread-out sample of the witnesses goes first, so a detailed object that does not
+    bound the room (most of them) is rejected after a few products; the products are chunked so
+    a 50k-triangle object never needs a (W, N) matrix."""
+    rows = max(1, _PRODUCT_ENTRIES // max(len(normals), 1))
+    sample = witnesses[:: max(1, len(witnesses) // 1024)]
+    for points in (sample, witnesses):
+        for i0 in range(0, len(points), rows):
+            if ((points[i0 : i0 + rows] @ normals.T - offsets) < -tol).any():
+                return False
+    return True
 
 
 def surface_keys(geometry: Geometry, *, angle_tolerance: float = 1e-3) -> np.ndarray:

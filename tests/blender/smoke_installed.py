@@ -54,7 +54,7 @@ def install(zip_path: Path) -> None:
     assert PACKAGE in bpy.context.preferences.addons, "the extension was installed but not enabled"
     repo = next(r for r in bpy.context.preferences.extensions.repos if r.module == "user_default")
     installed = Path(repo.directory) / "diminished_reality"
-    assert not (installed / "tests").exists() and (installed / "addon" / "latlong.py").is_file()
+    assert not (installed / "tests").exists() and (installed / "addon" / "geometry" / "latlong.py").is_file()
     # Blender extracts the wheel matching its own Python next to the repositories.
     site = Path(os.environ["BLENDER_USER_RESOURCES"]) / "extensions" / ".local"
     tag = "cpython-{}{}".format(*sys.version_info[:2])
