@@ -23,6 +23,7 @@ from ..light.radiosity import LUMA
 from ..quality import Params, rough
 from ..removal import RemovalResult, Solution, finish, solve, solve_lighting, traced_scene
 from ..removal.sequence import STAGES
+from ..removal.target import object_index
 from ..report import Report
 from ..scene import SceneData
 from .appearance import Carried, carry
@@ -48,9 +49,7 @@ def relocate(scene: SceneData, object_name: str, move: Move, *, planes: list[str
     new one with its shadow and reflected light. `callbacks.preview` gets difference images as
     for a removal, then one after each insertion pass."""
     params = params or Params()
-    if object_name not in scene.object_names:
-        raise DimredError(f"no mesh object named '{object_name}' among the scene's proxy geometry")
-    target = scene.object_names.index(object_name)
+    target = object_index(scene, object_name)
     if not (np.asarray(scene.tri_object) == target).any():
         raise DimredError(f"'{object_name}' has no faces to move")
     passes = params.insertion_passes

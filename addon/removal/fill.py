@@ -38,7 +38,8 @@ def fill_hidden(solution: Solution, rep: Report, callbacks: RunCallbacks,
     patch's mean reflectance, then after every synthesis level of every surface."""
     geo, room, traced = solution.geo, solution.room, solution.traced
     behind = traced.behind
-    lit = _revealed_light(solution, callbacks)
+    radiance = traced.panorama_rows(solution.hdri)
+    lit = _revealed_light(solution, radiance, callbacks)
     b = room.senders.radiosity
     rho = room.rho[lit.patch].copy()
     emit = room.emitter[lit.patch]
@@ -51,7 +52,7 @@ def fill_hidden(solution: Solution, rep: Report, callbacks: RunCallbacks,
 
     if show is not None:
         show(change())
-    panorama = _panorama_reflectance(solution)
+    panorama = _panorama_reflectance(solution, radiance)
     options = FillOptions(cell=_raster_cell(solution), margin=solution.params.exemplar_margin,
                           synthesis=SynthesisParams(neighbourhood=solution.params.synth_neighbourhood,
                                                     levels=solution.params.synth_levels,
@@ -85,19 +86,20 @@ def fill_hidden(solution: Solution, rep: Report, callbacks: RunCallbacks,
     return change()
 
 
-def _revealed_light(solution: Solution, callbacks: RunCallbacks) -> _Revealed:
+def _revealed_light(solution: Solution, radiance: np.ndarray, callbacks: RunCallbacks) -> _Revealed:
+    """The light of the revealed pixels, given every hit pixel's photographed radiance (N, 3)."""
     behind = solution.traced.behind
     fine = fine_light(solution.geo, solution.target, solution.room, solution.occlusion, solution.db,
                       solution.split, behind.tri, behind.bary, callbacks)
     patch, _, _ = solution.room.patches.lattice.locate(behind.tri, behind.bary)
     e_after = np.maximum(interpolate(fine.e_after, fine.corners, fine.weights), 0.0)
-    radiance = solution.traced.panorama_rows(solution.hdri)[behind.revealed]
-    return _Revealed(e_after, patch, radiance)
+    return _Revealed(e_after, patch, radiance[behind.revealed])
 
 
-def _panorama_reflectance(solution: Solution) -> PanoramaReflectance:
-    """rho = pi L / E wherever a pixel measures it (not hidden, not a light, not too dark),
-    and the surfaces every pixel sees with the object and without it."""
+def _panorama_reflectance(solution: Solution, radiance: np.ndarray) -> PanoramaReflectance:
+    """rho = pi L / E wherever a pixel measures it (not hidden, not a light, not too dark), from
+    the hit pixels' radiance L (N, 3); and the surfaces every pixel sees with the object and
+    without it."""
     traced, room, e_h = solution.traced, solution.room, solution.e_h
     keys = solution.target.surface_key
     n = traced.height * traced.width
@@ -108,7 +110,6 @@ def _panorama_reflectance(solution: Solution) -> PanoramaReflectance:
     surface_without = np.where(tri_without >= 0, keys[np.maximum(tri_without, 0)], -1)
     maps = PanoramaMaps(surface_with.reshape(shape), traced.hits.distance, surface_without.reshape(shape),
                         traced.behind.distance_without.reshape(shape), traced.hidden_map)
-    radiance = traced.panorama_rows(solution.hdri)
     e_ref = float(np.median(e_h @ LUMA))
     measured = ~traced.hidden_h & ~room.pixels.emitter_h & ((e_h @ LUMA) > 1e-3 * e_ref)
     rho = np.zeros((n, 3))

@@ -34,9 +34,10 @@ class FirstOrder:
     split: Split
 
 
-@dataclass(frozen=True)
+@dataclass
 class _Samples:
-    """k^2 points on each of n patches and what is known there."""
+    """k^2 points on each of n patches and what is known there: scratch of the first order,
+    whose transport it completes in place (never part of a stage's result)."""
 
     points: np.ndarray  # (n*k^2, 3)
     normals: np.ndarray  # (n*k^2, 3)
@@ -72,7 +73,8 @@ def first_order(room: Room, target: Target, occlusion: Occlusion, params: Params
         return FirstOrder(room, de, _split(room, de, [], params))
     k = params.patch_samples
     sampled = _sample(room, refine, k, occlusion, callbacks)
-    t_samples, t_samples_without = sampled.t_with.copy(), sampled.t_without.copy()
+    # The samples are this function's own: their transport is completed in place below.
+    t_samples, t_samples_without = sampled.t_with, sampled.t_without
     n, k2 = sampled.seen.shape[:2]
     e_samples = (t_samples @ b).reshape(n, k2, 3)
     n_seen = sampled.seen.sum(axis=1)
@@ -120,7 +122,7 @@ def _resample(room: Room, idx: np.ndarray, k: int, occlusion: Occlusion, rep: Re
     those points (each (n, k^2, 3))."""
     b = room.senders.radiosity.copy()
     sampled = _sample(room, idx, k, occlusion, callbacks)
-    t_samples, t_samples_without = sampled.t_with.copy(), sampled.t_without.copy()
+    t_samples, t_samples_without = sampled.t_with, sampled.t_without
     e_samples = (t_samples @ b).reshape(len(idx), k * k, 3)
     b_samples = np.where(sampled.seen, b[idx, None, :], room.rho[idx, None, :] * e_samples)
     b[idx] = b_samples.mean(axis=1)

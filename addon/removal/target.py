@@ -29,9 +29,7 @@ def prepare(scene: SceneData, object_name: str, planes: list[str] | tuple[str, .
             rep: Report) -> tuple[Geometry, Target]:
     """The scene's triangles in the probe frame and the object to remove; DimredError when the
     object or a --plane is unknown, the object has no faces or a --plane is not flat."""
-    if object_name not in scene.object_names:
-        raise DimredError(f"no mesh object named '{object_name}' among the scene's proxy geometry")
-    index = scene.object_names.index(object_name)
+    index = object_index(scene, object_name)
     with rep.stage("geometry"):
         geo = build_geometry(scene.triangles, scene.tri_object, scene.object_names, scene.center, scene.rotation)
         if not (geo.tri_object == index).any():
@@ -47,6 +45,14 @@ def prepare(scene: SceneData, object_name: str, planes: list[str] | tuple[str, .
     fine_cell = min(radius / params.fine_cells, params.fine_pixels * pixel)
     return geo, Target(index=index, planes=plane_ids, centre=centre, radius=radius, fine_cell=fine_cell,
                        eps=1e-6 * geo.scale, surface_key=surface_keys(geo))
+
+
+def object_index(scene: SceneData, object_name: str) -> int:
+    """The index of `object_name` among the scene's objects; DimredError when there is none."""
+    try:
+        return scene.object_index(object_name)
+    except KeyError:
+        raise DimredError(f"no mesh object named '{object_name}' among the scene's proxy geometry") from None
 
 
 def _plane_index(geo: Geometry, name: str) -> int:

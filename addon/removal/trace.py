@@ -35,8 +35,6 @@ class Traced:
     """The first hit of every pixel's ray; the `_h` arrays hold one row per hit pixel."""
 
     hits: PanoramaHits
-    width: int
-    height: int
     hp: np.ndarray  # (N,) flat panorama index of each hit pixel
     tri_h: np.ndarray  # (N,) triangle it sees
     obj_h: np.ndarray  # (N,) object it sees
@@ -45,6 +43,14 @@ class Traced:
     hidden_h: np.ndarray  # (N,) bool: filled rather than relit (the object and its silhouette)
     hidden_map: np.ndarray  # (H, W) bool: the same per panorama pixel
     behind: Behind
+
+    @property
+    def height(self) -> int:
+        return self.hits.tri.shape[0]
+
+    @property
+    def width(self) -> int:
+        return self.hits.tri.shape[1]
 
     def panorama_rows(self, image: np.ndarray) -> np.ndarray:
         """(N, 3) float64 values of an (H, W, 3) image at the hit pixels."""
@@ -76,7 +82,7 @@ def trace(geo: Geometry, target: Target, width: int, height: int, *, fill: bool,
     behind = Behind.nothing(height * width)
     if fill and hidden_h.any():
         behind = _behind(geo, target, width, height, hp, hidden_h, rep)
-    return Traced(hits=hits, width=width, height=height, hp=hp, tri_h=tri_h, obj_h=obj_h,
+    return Traced(hits=hits, hp=hp, tri_h=tri_h, obj_h=obj_h,
                   points_h=hits.points.reshape(-1, 3)[hp], normals_h=geo.normals[tri_h], hidden_h=hidden_h,
                   hidden_map=hidden_map.reshape(height, width), behind=behind)
 

@@ -21,6 +21,7 @@ from addon.errors import DimredError
 from addon.io import exr
 from addon.io.exr import read_exr, write_exr
 from addon.relocation.fixedview import Move
+from tests.blender.tiny_scene import environment_world
 
 pytestmark = pytest.mark.usefixtures("fresh_blender")
 
@@ -47,18 +48,10 @@ def _save_scene(folder: Path, image_path: Path | None = None) -> Path:
     _plane("Box", 0.6, 0.3)
     scene.collection.objects.link(bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera")))
     scene.collection.objects.link(bpy.data.objects.new("Lamp", bpy.data.lights.new("Lamp", 'POINT')))
-    world = bpy.data.worlds.new("Probe")
-    scene.world = world
-    if world.node_tree is None:
-        world.use_nodes = True  # Blender 4.x creates worlds without a node tree
-    nodes = world.node_tree.nodes
-    environment = nodes.new("ShaderNodeTexEnvironment")
     image = bpy.data.images.new("probe", 16, 8, float_buffer=True)
     image.source = 'FILE'
     image.filepath = str(image_path)
-    environment.image = image
-    background = next(node for node in nodes if node.bl_idname == "ShaderNodeBackground")
-    world.node_tree.links.new(environment.outputs["Color"], background.inputs["Color"])
+    scene.world, _ = environment_world(bpy, "Probe", image)
     path = folder / "room.blend"
     bpy.ops.wm.save_as_mainfile(filepath=str(path))
     return path

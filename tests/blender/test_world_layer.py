@@ -6,7 +6,7 @@ import bpy
 import numpy as np
 import pytest
 
-from tests.blender.tiny_scene import write_exr
+from tests.blender.tiny_scene import environment_world, write_exr
 
 
 @pytest.fixture
@@ -17,14 +17,8 @@ def world_layer(extension):
 
 
 def _world(with_mapping: bool) -> bpy.types.World:
-    world = bpy.data.worlds.new("Probe")
-    if world.node_tree is None:
-        world.use_nodes = True  # Blender 4.x creates worlds without a node tree
+    world, environment = environment_world(bpy, "Probe", bpy.data.images.new("hdri", 8, 4, float_buffer=True))
     nodes, links = world.node_tree.nodes, world.node_tree.links
-    background = next(n for n in nodes if n.type == 'BACKGROUND')
-    environment = nodes.new("ShaderNodeTexEnvironment")
-    environment.image = bpy.data.images.new("hdri", 8, 4, float_buffer=True)
-    links.new(environment.outputs["Color"], background.inputs["Color"])
     if with_mapping:
         coordinates = nodes.new("ShaderNodeTexCoord")
         mapping = nodes.new("ShaderNodeMapping")

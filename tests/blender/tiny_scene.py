@@ -33,6 +33,20 @@ def mesh_object(bpy, name: str, vertices: list, faces: list):
     return obj
 
 
+def environment_world(bpy, name: str, image):
+    """A new world `name` whose Background shows `image` through an Environment Texture;
+    returns (world, the Environment Texture node)."""
+    world = bpy.data.worlds.new(name)
+    if world.node_tree is None:
+        world.use_nodes = True  # Blender 4.x creates worlds without a node tree
+    nodes, links = world.node_tree.nodes, world.node_tree.links
+    background = next(n for n in nodes if n.type == 'BACKGROUND')
+    environment = nodes.new("ShaderNodeTexEnvironment")
+    environment.image = image
+    links.new(environment.outputs["Color"], background.inputs["Color"])
+    return world, environment
+
+
 def build_scene(hdri_path: str | Path) -> None:
     """Fill the current (empty) Blender scene with the room, lit by the HDRI at hdri_path."""
     import bpy
@@ -43,14 +57,7 @@ def build_scene(hdri_path: str | Path) -> None:
     probe.location = CENTER
     bpy.context.scene.collection.objects.link(probe)
 
-    world = bpy.data.worlds.new("Room Probe")
-    if world.node_tree is None:
-        world.use_nodes = True  # Blender 4.x creates worlds without a node tree
-    nodes, links = world.node_tree.nodes, world.node_tree.links
-    background = next(n for n in nodes if n.type == 'BACKGROUND')
-    environment = nodes.new("ShaderNodeTexEnvironment")
-    environment.image = bpy.data.images.load(str(hdri_path))
-    links.new(environment.outputs["Color"], background.inputs["Color"])
+    world, _ = environment_world(bpy, "Room Probe", bpy.data.images.load(str(hdri_path)))
     bpy.context.scene.world = world
 
 
