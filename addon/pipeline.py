@@ -54,8 +54,7 @@ def _run(scene: SceneData, quality: str, overrides: dict, compute: Callable[[Sce
     report["parameters"] = {k: getattr(params, k) for k in params.__dataclass_fields__}
     report["image_size"] = [int(scene.hdri.shape[1]), int(scene.hdri.shape[0])]
     report["notes"] = [*report.get("notes", []), *scene.notes]
-    edited = (original + result.difference).astype(np.float32) if negative else result.edited
-    return replace(result, edited=edited, report=report)
+    return replace(result, hdri=original, report=report)
 
 
 def remove_object(

@@ -97,8 +97,8 @@ def relocate(scene: SceneData, object_name: str, move: Move, *, planes: list[str
     hidden = removed.hidden_mask.ravel().copy()
     hidden[carried.pix] = True
     report = _relocation_report(removed.report, steps, insertion.as_dict(), move, placement, carried, passes)
-    return RemovalResult(difference=difference, edited=(photo + difference).astype(np.float32),
-                         hidden_mask=hidden.reshape(photo.shape[:2]), report=report)
+    return RemovalResult(difference=difference, hidden_mask=hidden.reshape(photo.shape[:2]), report=report,
+                         hdri=photo)
 
 
 def _inserted(new: Solution, without: np.ndarray, carried: Carried, callbacks: RunCallbacks

@@ -36,9 +36,19 @@ STAGES = 8  # the stages a removal reports progress for
 @dataclass(frozen=True)
 class RemovalResult:
     difference: np.ndarray  # (H, W, 3) float32, top row first
-    edited: np.ndarray  # (H, W, 3) float32: hdri + difference
     hidden_mask: np.ndarray  # (H, W) bool: pixels that showed the object
     report: dict
+    hdri: np.ndarray  # (H, W, 3) the panorama the difference applies to
+
+    @property
+    def edited(self) -> np.ndarray:
+        """(H, W, 3) float32 hdri + difference: a new full-size array on every call (writers
+        that stream take `edited_rows`)."""
+        return self.edited_rows(0, self.difference.shape[0])
+
+    def edited_rows(self, start: int, stop: int) -> np.ndarray:
+        """Rows start:stop of the edited panorama, float32."""
+        return (self.hdri[start:stop] + self.difference[start:stop]).astype(np.float32, copy=False)
 
 
 def traced_scene(scene: SceneData, object_name: str, planes: list[str] | tuple[str, ...], params: Params,
@@ -105,9 +115,9 @@ def finish(solution: Solution, rep: Report, callbacks: RunCallbacks = NO_CALLBAC
         rep.skip("synthesis", "the object is not visible from the probe centre: no hidden region to fill"
                  if not traced.hidden_h.any() else "nothing is behind the object to fill")
     difference = difference_image(d_revealed)
-    edited = (solution.hdri + difference).astype(np.float32)
     rep.info["hidden_region_filled"] = bool(len(revealed) == traced.hidden_h.sum())
-    return RemovalResult(difference=difference, edited=edited, hidden_mask=traced.hidden_map, report=rep.as_dict())
+    return RemovalResult(difference=difference, hidden_mask=traced.hidden_map, report=rep.as_dict(),
+                         hdri=solution.hdri)
 
 
 def remove(scene: SceneData, object_name: str, *, planes: list[str] | tuple[str, ...] = (),
