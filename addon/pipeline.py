@@ -13,6 +13,7 @@ import numpy as np
 from .callbacks import NO_CALLBACKS, RunCallbacks
 from .errors import DimredError
 from .quality import DEFAULT_QUALITY, Params, params_for
+from .radiance import clamped_rows, negative_pixels, non_finite_pixels
 from .relocation.fixedview import Move
 from .relocation.insertion import relocate
 from .removal import RemovalResult, remove
@@ -29,10 +30,10 @@ def validate(scene: SceneData) -> None:
     if hdri.shape[1] != 2 * hdri.shape[0]:
         raise DimredError(f"the world image is {hdri.shape[1]}x{hdri.shape[0]}: "
                           "a lat-long panorama is twice as wide as high")
-    bad = ~np.isfinite(hdri)
-    if bad.any():
+    bad = non_finite_pixels(hdri)
+    if bad:
         name = scene.hdri_path or "the world image"
-        raise DimredError(f"{name} contains {int(bad.any(axis=2).sum())} pixels with NaN or infinite values")
+        raise DimredError(f"{name} contains {bad} pixels with NaN or infinite values")
     if not np.isfinite(scene.center).all():
         raise DimredError("the probe centre is not a finite point")
 
@@ -41,12 +42,13 @@ def _run(scene: SceneData, quality: str, overrides: dict, compute: Callable[[Sce
          ) -> RemovalResult:
     validate(scene)
     params = params_for(quality, **overrides)
-    # Negative radiance is not light (a bad merge or a denoiser's ringing): the engine reads it
-    # as black, and those pixels are passed through as they are.
-    negative = int((scene.hdri < 0).any(axis=2).sum())
+    # Negative radiance is not light: the engine reads it as black (`radiance.clamped_rows`),
+    # and those pixels are passed through as they are. The stages read the panorama whole, so
+    # they get a clamped copy.
+    negative = negative_pixels(scene.hdri)
     original = scene.hdri
     if negative:
-        scene = replace(scene, hdri=np.maximum(scene.hdri, 0.0))
+        scene = replace(scene, hdri=clamped_rows(scene.hdri, 0, scene.hdri.shape[0]))
     result = compute(scene, params)
     report = dict(result.report)
     report["guards"] = {**report["guards"], "negative_input_pixels_clamped": negative}

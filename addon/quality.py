@@ -39,6 +39,10 @@ class Params:
     synth_levels: int = 0  # pyramid levels of the synthesis, 0 = from the hole's size
     synth_generations: int = 2  # synthesis passes per level: more settle seams, slower
     seed: int = 0  # the synthesis's random seed: the same seed gives the same fill
+    # the light is solved on a copy of the panorama at most this wide; the full-resolution
+    # panorama takes it from there (upsampled, refined where it is sharp, filled at its own size)
+    working_width: int = 1024
+    refine_pixels: int = 200_000  # full-resolution pixels on sharp shadow edges given their own light, at most
     # relocation: solver passes towards the inserted object's fixed point (2 at least: the first
     # lacks the object's reflected light)
     insertion_passes: int = 2
@@ -57,11 +61,11 @@ DESCRIPTIONS = {
 PRESETS = {
     "draft": Params(patches=200, object_patches=40, sender_fraction=0.9, max_senders=12, sender_samples=2,
                     fine_cells=2.0, fine_pixels=8.0, reach=0.15, significance=0.03, patch_samples=1, max_bounces=4,
-                    bounce_tolerance=1e-2),
+                    bounce_tolerance=1e-2, refine_pixels=50_000),
     "balanced": Params(),
     "final": Params(patches=1200, object_patches=300, sender_fraction=0.995, max_senders=64, sender_samples=6,
                     fine_cells=5.0, fine_pixels=3.0, reach=0.05, significance=0.003, patch_samples=3, max_bounces=16,
-                    bounce_tolerance=5e-4, insertion_passes=3),
+                    bounce_tolerance=5e-4, insertion_passes=3, working_width=2048, refine_pixels=800_000),
 }
 
 

@@ -1,137 +1,284 @@
 """Seconds and peak memory of a removal per panorama size and per object triangle count.
 
-    .venv/bin/python benchmarks/bench_scale.py [--sizes 1024,2048,4096] [--splits 1,9,29,64]
-                                               [--quality balanced] [--scene basic_box]
+    .venv/bin/python benchmarks/bench_scale.py [--sizes 1024,2048,4096,8192,16384]
+        [--splits 1,9,29,64] [--quality draft,balanced,final] [--engine] [--markdown]
+        [--truth-sizes 2048] [--scene basic_box] [--width 1024] [--samples 8]
 
-The scene is rendered at 1024x512 (cached under .cache/groundtruth). A larger panorama is that
-render upsampled (each pixel repeated), which is fine for timing; the error column is against
-the Cycles truth where one exists (the render's own size). The triangle counts come from
-splitting each of the removed box's 12 triangles into k^2 (the same shape, so the same truth):
-k = 1, 9, 29, 64 give 12, 972, 10092 and 49152 triangles. Every run is its own process reading
-the scene from a file (no bpy), so its peak resident memory (ru_maxrss) is the engine's alone.
-Timings on a shared machine are noisy: compare the rows of one run.
+Each row is one removal in a fresh process, measured from outside: wall seconds from its
+start to its exit and its peak resident memory (that child's rusage). By default the process
+is the command line as a user runs it (`python -m addon.cli remove SCENE.blend --object NAME
+--out DIR --quality Q`): bpy's start, opening the .blend, reading the panorama's EXR and writing
+the result's EXRs are part of the cost. With --engine it is the engine alone on the same input:
+the panorama read from its EXR, the geometry from an array file, no bpy, only the report written.
+
+The scene is rendered with Cycles at --width and at each of --truth-sizes (pairs cached under
+.cache/groundtruth; a missing one takes minutes); rows of a rendered size score the edit
+against the render without the object. Every other size is the --width render upsampled (each
+pixel repeated), fine for timing. The triangle counts come from splitting each of the removed
+object's triangles into k^2 at --width (the same surface, so the same truth): k = 1, 9, 29, 64
+give the box's 12, 972, 10092 and 49152 triangles. Each row's .blend (with the upsampled EXR
+as its world image, or the split mesh) is built once by a bpy subprocess and cached under
+.cache/bench_scale. The ratio columns divide by the row of the --width panorama with k = 1 of
+the same preset in the same run; the targets are 8K within 4x the 1K time and 3 GB, 16K
+within 8 GB, 49k triangles within 2x the 12-triangle time and memory. Timings on a shared
+machine are noisy: compare the rows of one run.
 """
 from __future__ import annotations
 
 import argparse
 import json
-import resource
+import os
 import subprocess
 import sys
 import tempfile
 import time
-from dataclasses import replace
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from rendered import arguments, open_scene
+from rendered import arguments
 from scenes import metrics
+from scenes import spec as scene_specs
+from scenes.images import read_exr
+from scenes.render import REPO, render_pair
+
+CACHE = REPO / ".cache" / "bench_scale"
+COLUMNS = ("preset", "path", "panorama", "source", "object triangles", "seconds", "time x1K",
+           "peak memory GB", "memory x1K", "error ratio", "slowest stages (s)")
 
 
-def _save(scene, path: Path) -> None:
-    np.savez(path, hdri=scene.hdri, rotation=scene.rotation, center=scene.center, triangles=scene.triangles,
-             tri_object=scene.tri_object, object_names=np.array(scene.object_names))
+@dataclass(frozen=True)
+class Case:
+    """One row's input: a `width` x width/2 panorama, upsampled `factor` times from the pair
+    `pair` (1: the pair's own render, which scores the edit), the object split into `split`^2."""
+
+    width: int
+    split: int
+    factor: int
+    pair: dict[str, Path]
+    folder: Path
 
 
-def _load(path: Path):
-    from addon.scene import SceneData
+@dataclass(frozen=True)
+class Measured:
+    """One run: exit status, wall seconds and peak resident GiB of its process, its output folder."""
 
-    data = np.load(path)
-    return SceneData(hdri=data["hdri"], rotation=data["rotation"], center=data["center"],
-                     triangles=data["triangles"], tri_object=data["tri_object"],
-                     object_names=[str(n) for n in data["object_names"]])
+    status: int
+    seconds: float
+    peak_gb: float
+    out: Path
 
 
-def _split_object(scene, name: str, k: int):
-    """The scene with each triangle of object `name` split into k^2 (same surface)."""
+def _cases(args: argparse.Namespace) -> list[Case]:
+    """The rows' inputs, built and cached: the sizes with k = 1, then the splits at --width."""
+    rendered = {args.width, *_ints(args.truth_sizes)}
+    cases = []
+    # The --width row first: the ratios divide by it.
+    sizes = sorted({args.width, *_ints(args.sizes)})
+    wanted = [(w, 1) for w in sizes] + [(args.width, k) for k in _ints(args.splits) if k != 1]
+    for width, split in wanted:
+        source = width if width in rendered else args.width
+        spec = scene_specs.get(args.scene).with_render(width=source, height=source // 2, samples=args.samples)
+        factor = width // source
+        folder = CACHE / spec.key() / f"x{factor}-k{split}"
+        case = Case(width, split, factor, render_pair(spec), folder)
+        if not (folder / "case.json").exists():
+            _setup(case, spec.remove)
+        cases.append(case)
+    return cases
+
+
+def _setup(case: Case, name: str) -> None:
+    print(f"building the {case.width}x{case.width // 2}, k={case.split} input in {case.folder}", file=sys.stderr)
+    case.folder.mkdir(parents=True, exist_ok=True)
+    command = [sys.executable, __file__, "--setup", str(case.folder), "--blend", str(case.pair["blend"]),
+               "--object", name, "--factor", str(case.factor), "--split", str(case.split)]
+    proc = subprocess.run(command, cwd=REPO, capture_output=True, text=True)
+    if proc.returncode:
+        sys.exit(f"building {case.folder} failed:\n{(proc.stdout + proc.stderr)[-3000:]}")
+
+
+def _build(args: argparse.Namespace) -> None:
+    """In a bpy subprocess: the pair's .blend with its world image upsampled and the object's
+    mesh split, saved as scene.blend with the geometry as geometry.npz; case.json comes last."""
+    import bpy
+
+    from addon.blender import reader
+    from addon.blender.cli import open_blend
+    from scenes.images import write_exr
+
+    open_blend(str(args.blend))
+    scene = bpy.context.scene
+    if args.factor > 1:
+        image = reader.environment_texture(scene).image
+        world = read_exr(bpy.path.abspath(image.filepath))
+        path = args.setup / "world.exr"
+        write_exr(path, np.repeat(np.repeat(world, args.factor, axis=0), args.factor, axis=1))
+        image.filepath = str(path)
+    if args.split > 1:
+        _split_mesh(bpy.data.objects[args.object], args.split)
+    bpy.ops.wm.save_as_mainfile(filepath=str(args.setup / "scene.blend"))
+    data = reader.read_scene(scene, defer_file=True)
+    np.savez(args.setup / "geometry.npz", rotation=data.rotation, center=data.center, triangles=data.triangles,
+             tri_object=data.tri_object, object_names=np.array(data.object_names), hdri_path=data.hdri_path)
+    triangles = int((data.tri_object == data.object_index(args.object)).sum())
+    (args.setup / "case.json").write_text(json.dumps({"triangles": triangles}))
+
+
+def _split_mesh(obj, k: int) -> None:
+    """Give `obj` a mesh of its triangles each split into k^2 (the same surface, unwelded)."""
+    import bpy
+
     from addon.geometry.patches import split_triangles
 
-    index = scene.object_names.index(name)
-    on = scene.tri_object == index
-    fine = split_triangles(scene.triangles[on], k).reshape(-1, 3, 3)
-    triangles = np.concatenate([scene.triangles[~on], fine])
-    owners = np.concatenate([scene.tri_object[~on], np.full(len(fine), index, dtype=scene.tri_object.dtype)])
-    return replace(scene, triangles=triangles, tri_object=owners)
+    mesh = obj.data
+    mesh.calc_loop_triangles()
+    coords = np.empty(len(mesh.vertices) * 3, dtype=np.float32)
+    mesh.vertices.foreach_get("co", coords)
+    corners = np.empty(len(mesh.loop_triangles) * 3, dtype=np.int32)
+    mesh.loop_triangles.foreach_get("vertices", corners)
+    fine = split_triangles(coords.reshape(-1, 3)[corners.reshape(-1, 3)].astype(np.float64), k).reshape(-1, 3)
+    split = bpy.data.meshes.new(f"{mesh.name}.split{k}")
+    split.vertices.add(len(fine))
+    split.vertices.foreach_set("co", fine.astype(np.float32).ravel())
+    split.loops.add(len(fine))
+    split.loops.foreach_set("vertex_index", np.arange(len(fine), dtype=np.int32))
+    split.polygons.add(len(fine) // 3)
+    split.polygons.foreach_set("loop_start", np.arange(0, len(fine), 3, dtype=np.int32))
+    split.update(calc_edges=True)
+    for material in mesh.materials:
+        split.materials.append(material)
+    obj.data = split
 
 
-def _child(args: argparse.Namespace) -> None:
-    """One removal, in this process: prints its seconds and peak memory as JSON."""
+def _engine(args: argparse.Namespace) -> None:
+    """In a subprocess without bpy: one removal of the case in `args.engine_child`; writes its
+    report (and the difference, for a scored row) into `args.out`."""
     from addon.pipeline import remove_object
+    from addon.run.job import loaded
+    from addon.scene import SceneData
 
-    scene = _load(args.child)
-    if args.split > 1:
-        scene = _split_object(scene, args.object, args.split)
-    factor = args.width // scene.hdri.shape[1]
-    if factor > 1:
-        scene = replace(scene, hdri=np.repeat(np.repeat(scene.hdri, factor, axis=0), factor, axis=1))
-    started = time.perf_counter()
+    data = np.load(args.engine_child / "geometry.npz")
+    scene = loaded(SceneData(hdri=None, rotation=data["rotation"], center=data["center"],
+                             triangles=data["triangles"], tri_object=data["tri_object"],
+                             object_names=[str(n) for n in data["object_names"]], hdri_path=str(data["hdri_path"])))
     result = remove_object(scene, args.object, quality=args.quality)
-    seconds = time.perf_counter() - started
+    args.out.mkdir(parents=True, exist_ok=True)
+    (args.out / "report.json").write_text(json.dumps(result.report))
     if args.difference:
-        np.save(args.difference, result.difference)
-    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20  # KiB -> GiB
-    triangles = int((scene.tri_object == scene.object_names.index(args.object)).sum())
-    print(json.dumps({"seconds": seconds, "peak_gb": peak, "triangles": triangles, "stages": result.report["seconds"]}))
+        np.save(args.out / "difference.npy", result.difference)
 
 
-def _run(npz: Path, name: str, width: int, split: int, quality: str, difference: Path | None) -> dict:
-    command = [sys.executable, __file__, "--child", str(npz), "--object", name, "--width", str(width),
-               "--split", str(split), "--quality", quality]
-    if difference is not None:
-        command += ["--difference", str(difference)]
-    proc = subprocess.run(command, capture_output=True, text=True)
-    if proc.returncode:
-        return {"error": (proc.stderr.strip().splitlines() or ["failed"])[-1]}
-    return json.loads(proc.stdout.strip().splitlines()[-1])
+def _measure(command: list[str], out: Path) -> Measured:
+    """Run `command` to its end with its output in out/log.txt."""
+    out.mkdir(parents=True)
+    started = time.perf_counter()
+    with open(out / "log.txt", "w") as log:
+        proc = subprocess.Popen(command, cwd=REPO, stdout=log, stderr=subprocess.STDOUT)
+        # wait4 returns this child's own rusage; RUSAGE_CHILDREN would hold the largest so far.
+        _, status, usage = os.wait4(proc.pid, 0)
+    proc.returncode = os.waitstatus_to_exitcode(status)
+    return Measured(proc.returncode, time.perf_counter() - started, usage.ru_maxrss / 2**20, out / "result")
+
+
+def _run(case: Case, name: str, quality: str, engine: bool, folder: Path) -> Measured:
+    out = folder / f"{quality}-{case.width}-k{case.split}"
+    if engine:
+        command = [sys.executable, __file__, "--engine-child", str(case.folder), "--object", name,
+                   "--quality", quality, "--out", str(out / "result")]
+        command += ["--difference"] if case.factor == 1 else []
+    else:
+        command = [sys.executable, "-m", "addon.cli", "remove", str(case.folder / "scene.blend"), "--object", name,
+                   "--out", str(out / "result"), "--quality", quality]
+    return _measure(command, out)
+
+
+def _error(case: Case, run: Measured, engine: bool) -> str:
+    """The lighting error ratio against the truth of a rendered size, else ''."""
+    if case.factor != 1:
+        return ""
+    inp, truth, mask = read_exr(case.pair["input"]), read_exr(case.pair["truth"]), np.load(case.pair["mask"])
+    edited = inp + np.load(run.out / "difference.npy") if engine else read_exr(run.out / "edited.exr")
+    return f"{metrics.lighting_error_ratio(inp, edited, truth, mask):.3f}"
+
+
+def _cells(quality: str, engine: bool, case: Case, run: Measured, base: Measured) -> list[str]:
+    panorama = f"{case.width}x{case.width // 2}"
+    source = "render" if case.factor == 1 else f"upsampled x{case.factor}"
+    head = [quality, "engine" if engine else "cli", panorama, source]
+    triangles = json.loads((case.folder / "case.json").read_text())["triangles"]
+    if run.status:
+        tail = (run.out.parent / "log.txt").read_text().strip().splitlines() or ["no output"]
+        return [*head, str(triangles), f"failed ({run.status}): {tail[-1]}", "", "", "", "", ""]
+    stages = json.loads((run.out / "report.json").read_text())["seconds"]
+    slowest = sorted(((v, k) for k, v in stages.items() if k not in ("total", "read_scene")), reverse=True)[:3]
+    ok = not base.status
+    return [*head, str(triangles), f"{run.seconds:.1f}", f"{run.seconds / base.seconds:.2f}" if ok else "",
+            f"{run.peak_gb:.2f}", f"{run.peak_gb / base.peak_gb:.2f}" if ok else "", _error(case, run, engine),
+            ", ".join(f"{k} {v:.1f}" for v, k in slowest)]
+
+
+def _print_table(rows: list[list[str]], markdown: bool) -> None:
+    if markdown:
+        print("| " + " | ".join(COLUMNS) + " |")
+        print("|" + "---|" * len(COLUMNS))
+        for row in rows:
+            print("| " + " | ".join(row) + " |")
+        return
+    widths = [max(len(r[i]) for r in [list(COLUMNS), *rows]) for i in range(len(COLUMNS))]
+    for row in [list(COLUMNS), *rows]:
+        print("  ".join(cell.ljust(w) for cell, w in zip(row, widths, strict=True)).rstrip())
+
+
+def _ints(text: str) -> list[int]:
+    return [int(x) for x in text.split(",") if x]
 
 
 def main() -> None:
     ap = arguments(__doc__)
-    ap.add_argument("--sizes", default="1024,2048,4096", help="panorama widths, multiples of the render's")
+    ap.set_defaults(samples=8)
+    ap.add_argument("--sizes", default="1024,2048,4096,8192,16384",
+                    help="panorama widths, multiples of --width (larger ones are upsampled)")
     ap.add_argument("--splits", default="1,9,29,64", help="k: each of the object's triangles split into k^2")
-    ap.add_argument("--quality", default="balanced")
-    ap.add_argument("--child", type=Path, help=argparse.SUPPRESS)
-    ap.add_argument("--object", default="Box", help=argparse.SUPPRESS)
+    ap.add_argument("--quality", default="balanced", help="presets, comma-separated")
+    ap.add_argument("--truth-sizes", default="2048", help="widths also rendered with Cycles, so scored")
+    ap.add_argument("--engine", action="store_true", help="the engine alone instead of the command line")
+    ap.add_argument("--markdown", action="store_true", help="print the table as markdown")
+    ap.add_argument("--setup", type=Path, help=argparse.SUPPRESS)
+    ap.add_argument("--blend", type=Path, help=argparse.SUPPRESS)
+    ap.add_argument("--factor", type=int, default=1, help=argparse.SUPPRESS)
     ap.add_argument("--split", type=int, default=1, help=argparse.SUPPRESS)
-    ap.add_argument("--difference", type=Path, help=argparse.SUPPRESS)
+    ap.add_argument("--engine-child", type=Path, help=argparse.SUPPRESS)
+    ap.add_argument("--object", help=argparse.SUPPRESS)
+    ap.add_argument("--out", type=Path, help=argparse.SUPPRESS)
+    ap.add_argument("--difference", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args()
-    if args.child is not None:
-        _child(args)
+    if args.setup is not None:
+        _build(args)
         return
-    spec, paths = open_scene(args)
-
-    import bpy
-
-    from addon.blender import reader
-    from scenes.images import read_exr
-
-    inp, truth, mask = read_exr(paths["input"]), read_exr(paths["truth"]), np.load(paths["mask"])
+    if args.engine_child is not None:
+        _engine(args)
+        return
+    if any(w % args.width for w in _ints(args.sizes)):
+        ap.error("--sizes must be multiples of --width")
+    name = scene_specs.get(args.scene).remove
+    cases = _cases(args)
+    pair = cases[0].pair
+    floor = metrics.noise_floor(read_exr(pair["input"]), read_exr(pair["truth"]), np.load(pair["mask"]))
+    print(f"scene {args.scene} rendered {args.width}x{args.width // 2} @ {args.samples} spp; noise floor {floor:.3f}; "
+          f"seconds: process wall time; peak memory: its maximum resident set")
+    rows = []
     with tempfile.TemporaryDirectory() as folder:
-        npz = Path(folder) / "scene.npz"
-        _save(reader.read_scene(bpy.context.scene), npz)
-        print(f"scene {args.scene} rendered {args.width}x{args.width // 2} @ {args.samples} spp, "
-              f"{args.quality}; noise floor {metrics.noise_floor(inp, truth, mask):.3f}")
-        print("| panorama | object triangles | seconds | peak memory GB | error ratio | slowest stages |")
-        print("|---|---|---|---|---|---|")
-        cases = [(w, 1) for w in map(int, args.sizes.split(","))]
-        cases += [(args.width, k) for k in map(int, args.splits.split(",")) if k != 1]
-        for width, split in cases:
-            difference = Path(folder) / "difference.npy" if width == args.width else None
-            row = _run(npz, spec.remove, width, split, args.quality, difference)
-            if "error" in row:
-                print(f"| {width}x{width // 2} | k={split} | failed: {row['error']} | | | |", flush=True)
-                continue
-            error = ""
-            if difference is not None:
-                edited = inp + np.load(difference)
-                error = f"{metrics.lighting_error_ratio(inp, edited, truth, mask):.3f}"
-            stages = sorted(((v, k) for k, v in row["stages"].items() if k != "total"), reverse=True)[:3]
-            slowest = ", ".join(f"{k} {v:.1f}" for v, k in stages)
-            print(f"| {width}x{width // 2} | {row['triangles']} | {row['seconds']:.1f} | {row['peak_gb']:.2f} | "
-                  f"{error} | {slowest} |", flush=True)
+        for quality in args.quality.split(","):
+            base = _run(cases[0], name, quality, args.engine, Path(folder))
+            for case in cases:
+                run = base if case is cases[0] else _run(case, name, quality, args.engine, Path(folder))
+                rows.append(_cells(quality, args.engine, case, run, base))
+                print(" | ".join(rows[-1]), file=sys.stderr, flush=True)
+    _print_table(rows, args.markdown)
 
 
 if __name__ == "__main__":

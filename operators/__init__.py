@@ -2,10 +2,10 @@
 from __future__ import annotations
 
 from . import marking, relocate, remove, settings
-from .support import session
+from .support import session, warmup
 
 # Settings first: the operators and the panel read scene.dimred.
-_modules = (settings, session, marking, remove, relocate)
+_modules = (settings, session, warmup, marking, remove, relocate)
 
 
 def register() -> None:

@@ -31,6 +31,14 @@ def _is_mesh(_settings: bpy.types.PropertyGroup, obj: bpy.types.Object) -> bool:
     return obj.type == 'MESH'
 
 
+def _target_changed(settings: bpy.types.PropertyGroup, _context: bpy.types.Context) -> None:
+    # A Remove is likely next: its first preview wants a small copy of the panorama ready.
+    if settings.target is not None:
+        from .support import warmup
+
+        warmup.warm(settings.id_data)
+
+
 class DimredSurface(bpy.types.PropertyGroup):
     """One surface the removal is asked to edit (the floor under the object, a wall)."""
 
@@ -120,6 +128,7 @@ class DimredSettings(bpy.types.PropertyGroup):
         description="The real object to remove from the panorama",
         type=bpy.types.Object,
         poll=_is_mesh,
+        update=_target_changed,
     )
     # Where the marked object stood when it was marked (the proxy aligned with the photograph):
     # Relocate "from transform" measures the artist's G/R move from there.

@@ -20,12 +20,17 @@ import sys
 import tempfile
 import time
 from collections.abc import Callable, Iterator, Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .. import memory
 from ..callbacks import RunCallbacks
 from ..errors import DimredError
 from ..quality import DEFAULT_QUALITY, DESCRIPTIONS
+
+if TYPE_CHECKING:
+    from ..removal import RemovalResult
 
 PROG = "dimred"
 #: Exit status for bad input (the same as argparse's usage errors).
@@ -199,6 +204,9 @@ def _run(args: argparse.Namespace, done: str, compute: Callable[..., object]) ->
         if plane == args.object:
             raise DimredError(f"'{plane}' is the object itself; it cannot also be a --plane")
         reader.check_object(scene, plane, purpose="used as a --plane")
+    # Before the pixels are read: a run that cannot fit is refused now, not killed halfway.
+    width, height = reader.panorama_size(scene)
+    memory.check_fits(width, height, quality=args.quality)
     scene_data = reader.read_scene(scene, center=args.center)
     loaded = time.perf_counter()
     if args.verbose:
@@ -215,9 +223,7 @@ def _run(args: argparse.Namespace, done: str, compute: Callable[..., object]) ->
     seconds["read_scene"] = round(loaded - started, 4)
     seconds["total"] = round(time.perf_counter() - started, 4)
     report["seconds"] = seconds
-    images = {"difference.exr": result.difference, "edited.exr": result.edited}
-    mask = result.hidden_mask if report.get("hidden_region_filled") is False else None
-    write_outputs(out, images, mask, report)
+    write_outputs(out, result, report)
     total = time.perf_counter() - started
     print(f"{PROG}: {done} '{args.object}' in {total:.1f} s; wrote {out}", flush=True)
     for warning in report.get("warnings", []):
@@ -240,18 +246,21 @@ def open_blend(path: str) -> None:
             raise DimredError(f"cannot open {path}: {reason}") from None
 
 
-def write_outputs(out: str, images: dict[str, np.ndarray], mask: np.ndarray | None, report: dict) -> None:
+def write_outputs(out: str, result: RemovalResult, report: dict) -> None:
     """Write the result files into `out`, all or nothing.
 
     Everything is written into a hidden staging folder first (inside `out` when it exists,
     else in its deepest existing parent, so the final renames stay on one file system) and
     moved in only when complete: a failure leaves `out` and earlier results in it as they were.
+    The images are written a band of rows at a time (the edited panorama never exists whole)
+    and refused at the first band with a non-finite value.
     """
-    from ..io.exr import write_exr, write_png
+    from ..io.exr import write_exr_rows, write_png
 
-    for name, image in images.items():
-        if not np.all(np.isfinite(image)):
-            raise DimredError(f"the removal produced non-finite values in {name}; nothing was written")
+    height, width = result.difference.shape[:2]
+    images = {"difference.exr": lambda start, stop: result.difference[start:stop],
+              "edited.exr": result.edited_rows}
+    mask = result.hidden_mask if report.get("hidden_region_filled") is False else None
     try:
         payload = json.dumps(report, indent=2, allow_nan=False)
     except (TypeError, ValueError) as error:
@@ -261,8 +270,8 @@ def write_outputs(out: str, images: dict[str, np.ndarray], mask: np.ndarray | No
     except OSError as error:
         raise DimredError(f"cannot write into {out}: {error.strerror or error}") from None
     try:
-        for name, image in images.items():
-            write_exr(os.path.join(staging, name), image)
+        for name, rows in images.items():
+            write_exr_rows(os.path.join(staging, name), height, width, _finite(name, rows))
         if mask is not None:
             write_png(os.path.join(staging, "hidden_mask.png"), np.where(mask, 255, 0).astype(np.uint8))
         with open(os.path.join(staging, "report.json"), "w", encoding="utf-8") as handle:
@@ -278,6 +287,18 @@ def write_outputs(out: str, images: dict[str, np.ndarray], mask: np.ndarray | No
         raise DimredError(f"cannot write into {out}: {error.strerror or error}") from None
     finally:
         shutil.rmtree(staging, ignore_errors=True)
+
+
+def _finite(name: str, rows: Callable[[int, int], np.ndarray]) -> Callable[[int, int], np.ndarray]:
+    """`rows`, refusing a band with a NaN or infinite value (the staged files are then dropped)."""
+
+    def checked(start: int, stop: int) -> np.ndarray:
+        band = rows(start, stop)
+        if not np.isfinite(band).all():
+            raise DimredError(f"the removal produced non-finite values in {name}; nothing was written")
+        return band
+
+    return checked
 
 
 def _existing_folder(path: str) -> str:

@@ -13,7 +13,8 @@ import bpy
 import numpy as np
 
 from ..errors import DimredError
-from ..io.exr import read_exr
+from ..io.exr import exr_size, read_exr
+from ..radiance import row_bands
 from ..scene import SceneData
 
 #: Nodes whose name or label starts with this belong to the add-on (the difference layer).
@@ -80,6 +81,17 @@ def check_object(scene: bpy.types.Scene, name: str, *, purpose: str = "removed")
         raise DimredError(f"'{name}' is a {obj.type}, not a mesh: only mesh objects can be {purpose}")
     if obj not in _render_visible_objects(scene):
         raise DimredError(f"'{name}' is hidden for render, so it is not in the scene's geometry: make it visible first")
+
+
+def panorama_size(scene: bpy.types.Scene) -> tuple[int, int]:
+    """(width, height) of the panorama `read_scene` reads, without reading its pixels where it
+    reads them from an EXR file (the file's header), else from the image Blender loads: what
+    `memory.check_fits` needs before a run starts."""
+    image = environment_texture(scene).image
+    path = _image_path(image)
+    if _is_exact_file(image, path):
+        return exr_size(path)
+    return _loaded_size(image, path)
 
 
 def environment_texture(scene: bpy.types.Scene) -> bpy.types.ShaderNodeTexEnvironment:
@@ -266,45 +278,95 @@ def _panorama(image: bpy.types.Image, notes: list[str], defer_file: bool = False
     """(H, W, 3) float32 linear RGB, top row first, as Cycles renders `image`; and its path.
 
     With `defer_file`, None instead of the pixels when they are exactly the EXR file's."""
-    if image.source not in ("FILE", "GENERATED"):
-        raise DimredError(f"image '{image.name}' is a {image.source.lower()} image: use a single panorama file")
-    path = ""
-    if image.source == "FILE":
-        path = os.path.normpath(bpy.path.abspath(image.filepath, library=image.library))
-        if image.packed_file is None and not os.path.isfile(path):
-            raise DimredError(f"cannot load image '{image.name}': file not found: {path}")
-    colour = image.colorspace_settings
+    path = _image_path(image)
     if _is_exact_file(image, path):
         # Blender's buffer holds the same values; the file is read to skip Blender's image cache.
         return (None if defer_file else read_exr(path)), path
-    count = len(image.pixels)
-    width, height = image.size
-    if count == 0 or width * height == 0:
-        if image.source == "FILE" and image.packed_file is None:
-            raise DimredError(f"cannot load image '{image.name}' from {path}: Blender cannot read the file")
-        raise DimredError(f"image '{image.name}' has no pixels")
-    flat = np.empty(count, dtype=np.float32)
-    image.pixels.foreach_get(flat)
-    # Image.pixels starts at the bottom-left; the engine's rows start at the top.
-    pixels = flat.reshape(height, width, count // (width * height))[::-1]
-    rgb = pixels[..., :3] if pixels.shape[2] >= 3 else np.repeat(pixels[..., :1], 3, axis=2)
+    colour = image.colorspace_settings
+    width, height = _loaded_size(image, path)
     if image.is_float:
         if not colour.is_data and not _is_linear(colour.name):
             notes.append(
                 f"image '{image.name}' is tagged '{colour.name}', a non-linear colour space unusual for HDR data; "
                 "it was linearised as Blender renders it (set Linear Rec.709 if the file holds linear radiance)"
             )
-        return np.ascontiguousarray(rgb), path
+        return _blender_rgb(image, width, height), path
     # Blender hands out 8-bit images as stored (code value / 255), without colour management.
+    if colour.name != "sRGB" and not colour.is_data and not _is_linear(colour.name):
+        raise DimredError(
+            f"8-bit image '{image.name}' is in colour space '{colour.name}', which cannot be linearised here: "
+            "use an HDR file (EXR, HDR) or set sRGB"
+        )
     notes.append(f"image '{image.name}' is 8-bit, not HDR: light sources in it are clipped")
+    rgb = _blender_rgb(image, width, height)
     if colour.name == "sRGB":
-        return _srgb_to_linear(rgb), path
-    if colour.is_data or _is_linear(colour.name):
-        return np.ascontiguousarray(rgb), path
-    raise DimredError(
-        f"8-bit image '{image.name}' is in colour space '{colour.name}', which cannot be linearised here: "
-        "use an HDR file (EXR, HDR) or set sRGB"
-    )
+        _srgb_to_linear(rgb)
+    return rgb, path
+
+
+def _image_path(image: bpy.types.Image) -> str:
+    """The file `image` comes from ("" for a generated image); DimredError for a source the
+    engine cannot read or a file that is not there."""
+    if image.source not in ("FILE", "GENERATED"):
+        raise DimredError(f"image '{image.name}' is a {image.source.lower()} image: use a single panorama file")
+    if image.source == "GENERATED":
+        return ""
+    path = os.path.normpath(bpy.path.abspath(image.filepath, library=image.library))
+    if image.packed_file is None and not os.path.isfile(path):
+        raise DimredError(f"cannot load image '{image.name}': file not found: {path}")
+    return path
+
+
+def _loaded_size(image: bpy.types.Image, path: str) -> tuple[int, int]:
+    """(width, height) of the pixels Blender holds for `image` (asking loads them)."""
+    count = len(image.pixels)
+    width, height = image.size
+    if count == 0 or width * height == 0:
+        if image.source == "FILE" and image.packed_file is None:
+            raise DimredError(f"cannot load image '{image.name}' from {path}: Blender cannot read the file")
+        raise DimredError(f"image '{image.name}' has no pixels")
+    return width, height
+
+
+def _blender_rgb(image: bpy.types.Image, width: int, height: int) -> np.ndarray:
+    """(H, W, 3) float32 of Blender's pixels for `image`, top row first, in the one array they
+    are copied into: each pixel's colour is moved to the front of the RGBA buffer and the buffer
+    shrunk to it, and the rows (Blender's start at the bottom) are swapped, all in place."""
+    flat = np.empty(len(image.pixels), np.float32)
+    image.pixels.foreach_get(flat)
+    channels = flat.size // (width * height)
+    if channels < 3:
+        # Grey: the RGB image is larger than Blender's buffer.
+        rgb = np.repeat(flat.reshape(height, width, channels)[..., :1], 3, axis=2)
+    else:
+        if channels > 3:
+            _pack_rgb(flat, width, height, channels)
+            # No view of `flat` outlives _pack_rgb, so numpy's check for views, which miscounts
+            # references under a debugger, is left out. Shrinking gives the tail back in place.
+            flat.resize(height * width * 3, refcheck=False)
+        rgb = flat.reshape(height, width, 3)
+    _flip_rows(rgb)
+    return rgb
+
+
+def _pack_rgb(flat: np.ndarray, width: int, height: int, channels: int) -> None:
+    """Move each pixel's first three of `channels` values to the front of `flat`, in place.
+
+    A band's colour lands where only that band and earlier ones lay, so going from the start
+    overwrites nothing still to be read (numpy buffers a band that overlaps its destination).
+    """
+    for start, stop in row_bands(height, width):
+        source = flat[start * width * channels:stop * width * channels].reshape(stop - start, width, channels)
+        flat[start * width * 3:stop * width * 3].reshape(stop - start, width, 3)[...] = source[..., :3]
+
+
+def _flip_rows(rgb: np.ndarray) -> None:
+    """Reverse the order of the rows of `rgb` in place, a band from each end at a time."""
+    height, width = rgb.shape[:2]
+    for start, stop in row_bands(height // 2, width):
+        top = rgb[start:stop].copy()
+        rgb[start:stop] = rgb[height - stop:height - start][::-1]
+        rgb[height - stop:height - start] = top[::-1]
 
 
 def _is_exact_file(image: bpy.types.Image, path: str) -> bool:
@@ -327,10 +389,13 @@ def _is_linear(name: str) -> bool:
     return name.startswith("Linear") or name in {"scene_linear", "ACEScg", "ACES2065-1", "Non-Color", "Raw"}
 
 
-def _srgb_to_linear(encoded: np.ndarray) -> np.ndarray:
-    """The sRGB transfer function (IEC 61966-2-1), as Blender's "sRGB" colour space decodes."""
-    encoded = encoded.astype(np.float32)
-    return np.where(encoded <= 0.04045, encoded / 12.92, ((encoded + 0.055) / 1.055) ** 2.4).astype(np.float32)
+def _srgb_to_linear(rgb: np.ndarray) -> None:
+    """Decode the sRGB code values in `rgb` in place, band by band, with the sRGB transfer
+    function (IEC 61966-2-1), as Blender's "sRGB" colour space decodes."""
+    height, width = rgb.shape[:2]
+    for start, stop in row_bands(height, width):
+        band = rgb[start:stop]
+        band[...] = np.where(band <= 0.04045, band / 12.92, ((band + 0.055) / 1.055) ** 2.4)
 
 
 def _stored_probe_center(scene: bpy.types.Scene) -> tuple[object, str] | None:

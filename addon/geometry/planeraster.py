@@ -92,27 +92,52 @@ def build_raster(normal: np.ndarray, hidden_points: np.ndarray, *, cell: float, 
     return PlaneRaster(origin=origin, u=u, v=v, cell=cell, shape=shape)
 
 
+@dataclass(frozen=True)
+class Frame:
+    """Where an (h, w) array of panorama pixels lies in the full W x H panorama: its first row
+    and first column (its columns wrap around the seam). The whole panorama is (0, 0, H, W)."""
+
+    row0: int
+    col0: int
+    height: int
+    width: int
+
+    @classmethod
+    def whole(cls, shape: tuple[int, ...]) -> Frame:
+        return cls(0, 0, shape[0], shape[1])
+
+    def locate(self, rows: np.ndarray, cols: np.ndarray, shape: tuple[int, ...]
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Panorama (row, column) pixels -> the array's (row, column) and whether it holds them."""
+        r = rows - self.row0
+        c = np.mod(cols - self.col0, self.width)
+        inside = (r >= 0) & (r < shape[0]) & (c < shape[1])
+        return np.clip(r, 0, shape[0] - 1), np.minimum(c, shape[1] - 1), inside
+
+
 def classify(raster: PlaneRaster, surface_with: np.ndarray, distance_with: np.ndarray,
              surface_without: np.ndarray, distance_without: np.ndarray, hidden_by_target: np.ndarray,
-             *, surface: int, tolerance: float) -> np.ndarray:
+             *, surface: int, tolerance: float, frame: Frame | None = None) -> np.ndarray:
     """(h, w) SEEN / HIDDEN / OTHER for each cell.
 
-    The panorama maps are (H, W): the surface id each pixel's ray hits first and at what
-    distance, with the object and without it, and whether the object is that first hit. A cell
-    is on the surface where the ray through it, without the object, meets this surface at the
-    cell's own distance (within `tolerance`, relative, plus a pixel's depth span)."""
+    The panorama maps hold the pixels of `frame` (default: the whole panorama): the surface id
+    each pixel's ray hits first and at what distance, with the object and without it, and
+    whether the object is that first hit. A cell is on the surface where the ray through it,
+    without the object, meets this surface at the cell's own distance (within `tolerance`,
+    relative, plus a pixel's depth span); cells outside the frame are OTHER."""
+    frame = frame or Frame.whole(surface_with.shape)
     pts = raster.points()
     dist = np.linalg.norm(pts, axis=-1)
     u, v = latlong.direction_to_uv(pts)
-    row, col = latlong.uv_to_pixel(u, v, surface_with.shape[1], surface_with.shape[0])
+    row, col, inside = frame.locate(*latlong.uv_to_pixel(u, v, frame.width, frame.height), surface_with.shape)
 
     # The pixel's own ray is up to half a pixel off the cell's: on a plane seen at a grazing
     # angle that moves its hit point along the ray by about dist * pixel angle / cos.
     cos = np.abs(pts @ np.cross(raster.u, raster.v)) / np.maximum(dist, 1e-300)
-    slack = dist * (tolerance + np.pi / surface_with.shape[0] / np.maximum(cos, 0.05))
+    slack = dist * (tolerance + np.pi / frame.height / np.maximum(cos, 0.05))
 
     def meets(surf: np.ndarray, d: np.ndarray) -> np.ndarray:
-        return (surf[row, col] == surface) & (np.abs(d[row, col] - dist) <= slack)
+        return inside & (surf[row, col] == surface) & (np.abs(d[row, col] - dist) <= slack)
 
     flags = np.full(raster.shape, OTHER, dtype=np.int8)
     flags[meets(surface_with, distance_with)] = SEEN
@@ -120,15 +145,27 @@ def classify(raster: PlaneRaster, surface_with: np.ndarray, distance_with: np.nd
     return flags
 
 
-def sample_panorama(raster: PlaneRaster, image: np.ndarray, valid: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Bilinear lookup of a panorama image (H, W, C) at the cells, from `valid` pixels only:
-    (h, w, C) values and (h, w) the weight the valid pixels had (0 where none)."""
+def sample_panorama(raster: PlaneRaster, image: np.ndarray, valid: np.ndarray, *, frame: Frame | None = None
+                    ) -> tuple[np.ndarray, np.ndarray]:
+    """Bilinear lookup of panorama pixels (h, w, C) covering `frame` (default: the whole
+    panorama) at the cells, from `valid` pixels only: (h, w, C) values and (h, w) the weight
+    the valid pixels had (0 where none)."""
+    frame = frame or Frame.whole(image.shape)
     u, v = latlong.direction_to_uv(raster.points())
-    stacked = np.concatenate([image * valid[..., None], valid[..., None].astype(np.float64)], axis=-1)
-    sampled = latlong.sample_bilinear(stacked, u, v)
-    weight = sampled[..., -1]
-    values = sampled[..., :-1] / np.where(weight > 0.0, weight, 1.0)[..., None]
-    return values, weight
+    x = u * frame.width - 0.5
+    y = np.clip((1.0 - v) * frame.height - 0.5, 0.0, frame.height - 1.0)  # clamped at the poles
+    x0, y0 = np.floor(x), np.floor(y)
+    fx, fy = x - x0, y - y0
+    total = np.zeros((*raster.shape, image.shape[2]))
+    weight = np.zeros(raster.shape)
+    for dy, wy in ((0, 1.0 - fy), (1, fy)):
+        for dx, wx in ((0, 1.0 - fx), (1, fx)):
+            rows = np.minimum(y0.astype(np.int64) + dy, frame.height - 1)
+            r, c, inside = frame.locate(rows, x0.astype(np.int64) + dx, image.shape)
+            w = wy * wx * (inside & valid[r, c])
+            total += w[..., None] * image[r, c]
+            weight += w
+    return total / np.where(weight > 0.0, weight, 1.0)[..., None], weight
 
 
 def sample_raster(raster: PlaneRaster, image: np.ndarray, points: np.ndarray) -> np.ndarray:

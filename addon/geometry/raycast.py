@@ -1,10 +1,9 @@
-"""Vectorised ray casting: what each panorama pixel sees, and which segments are blocked.
+"""Vectorised ray casting: what each panorama pixel sees, and the hits of a few rays.
 
 `trace_panorama` rasterises every triangle into the lat-long image as seen from the probe
 (the origin of the probe frame) with a depth buffer: a ray from the probe is a pixel, so this
-is exact first-hit ray casting without a loop over pixels. `Occluders` answers "is the segment
-p0 -> p1 blocked?" for many segments at once through a two-level bounding-box hierarchy
-(object, then clusters of 16 triangles), so the cost follows what the segments pass near.
+is exact first-hit ray casting without a loop over pixels. `first_hits` and `crossings` test
+a few rays against every triangle. Which segments are blocked is `occluders.Occluders`.
 """
 from __future__ import annotations
 
@@ -16,10 +15,7 @@ from . import latlong
 
 _EDGE_SAMPLES = 17
 _BATCH_PIXELS = 1 << 21
-_CLUSTER = 16
 _PAIR_CHUNK = 40_000
-_SEG_CHUNK = 200_000
-_END_GAP = 30.0  # segment ends stop this many tolerances short of the surfaces they join
 
 
 @dataclass
@@ -100,13 +96,18 @@ def _inside(tris: np.ndarray, dirs: np.ndarray) -> np.ndarray:
     return (np.einsum("tkc,dc->tdk", _edge_normals(tris), dirs) >= 0.0).all(axis=2)
 
 
-def _rasterise(tris, tri_ids, row0, nrows, col0, ncols, dirs, best, out) -> None:
-    """Depth-test one batch of triangles that share a window shape into the buffers."""
+def _rasterise(tris, tri_ids, row0, nrows, col0, ncols, dirs, window, best, out) -> None:
+    """Depth-test one batch of triangles that share a window shape into the buffers, which
+    hold the pixels of `window` (first row, first column, panorama width): `dirs` (h, w, 3)."""
     h, w = dirs.shape[:2]
-    rows = row0[:, None, None] + np.arange(nrows)[None, :, None]
-    cols = np.mod(col0[:, None, None] + np.arange(ncols)[None, None, :], w)
-    rows = np.broadcast_to(np.minimum(rows, h - 1), (len(tris), nrows, ncols))
-    cols = np.broadcast_to(cols, (len(tris), nrows, ncols))
+    win_row, win_col, full_width = window
+    rows = row0[:, None, None] + np.arange(nrows)[None, :, None] - win_row
+    cols = np.mod(col0[:, None, None] + np.arange(ncols)[None, None, :] - win_col, full_width)
+    # Rows past the pole or the window's end were clamped onto its last row, and columns
+    # outside a partial window onto its last column: the clamped duplicates are dropped.
+    in_window = (rows >= 0) & (rows < h) & (cols < w)
+    rows = np.broadcast_to(np.clip(rows, 0, h - 1), (len(tris), nrows, ncols))
+    cols = np.broadcast_to(np.minimum(cols, w - 1), (len(tris), nrows, ncols))
     rays = dirs[rows, cols]  # (B, nr, nc, 3)
     edge_normals = _edge_normals(tris)
     # Unnormalised barycentric weights: each ray's side of the planes through the origin and an edge.
@@ -117,9 +118,7 @@ def _rasterise(tris, tri_ids, row0, nrows, col0, ncols, dirs, best, out) -> None
     normal_dot_corner = np.einsum("bc,bc->b", normal, tris[:, 0])
     with np.errstate(divide="ignore", invalid="ignore"):
         dist = normal_dot_corner[:, None, None] / normal_dot_ray
-    ok = inside & (dist > 0.0) & np.isfinite(dist)
-    # Rows past the pole were clamped onto the last row: drop the duplicates.
-    ok &= (row0[:, None, None] + np.arange(nrows)[None, :, None]) < h
+    ok = inside & (dist > 0.0) & np.isfinite(dist) & in_window
     tri, row, col = np.nonzero(ok)
     if len(tri) == 0:
         return
@@ -139,18 +138,28 @@ def _rasterise(tris, tri_ids, row0, nrows, col0, ncols, dirs, best, out) -> None
     out["bary"].reshape(-1, 2)[pix] = bary[:, 1:]
 
 
-def trace_panorama(triangles: np.ndarray, width: int, height: int) -> PanoramaHits:
-    """First hit of each pixel centre's ray from the origin among `triangles` (T, 3, 3)."""
-    dirs = latlong.pixel_directions(width, height)
-    best = np.full((height, width), np.inf)
-    out = {"tri": np.full((height, width), -1, dtype=np.int64), "bary": np.zeros((height, width, 2))}
+def trace_panorama(triangles: np.ndarray, width: int, height: int, *,
+                   window: tuple[int, int, int, int] | None = None) -> PanoramaHits:
+    """First hit of each pixel centre's ray from the origin among `triangles` (T, 3, 3), over
+    the whole W x H panorama or only its `window` (first row, rows, first column, columns;
+    the columns wrap around the seam): the hits then have the window's shape."""
+    row_start, nrows_w, col_start, ncols_w = window or (0, height, 0, width)
+    dirs = window_directions(width, height, (row_start, nrows_w, col_start, ncols_w))
+    best = np.full((nrows_w, ncols_w), np.inf)
+    out = {"tri": np.full((nrows_w, ncols_w), -1, dtype=np.int64), "bary": np.zeros((nrows_w, ncols_w, 2))}
     det = np.einsum("ij,ij->i", triangles[:, 0], np.cross(triangles[:, 1], triangles[:, 2]))
     scale = np.linalg.norm(triangles, axis=2).max(axis=1) ** 3
     seen = np.flatnonzero(np.abs(det) > 1e-12 * scale)  # edge-on triangles cover no pixel centre
     if len(seen):
         row0, nrows, col0, ncols = _uv_window(triangles[seen], width, height)
+        # Only the rows inside the window are worth testing.
+        row1 = np.minimum(row0 + nrows, row_start + nrows_w)
+        row0 = np.maximum(row0, row_start)
+        inside = row1 > row0
+        seen, row0, nrows, col0, ncols = seen[inside], row0[inside], (row1 - row0)[inside], col0[inside], ncols[inside]
         size = np.maximum(nrows, ncols)
         bucket = np.maximum(2, np.ceil(np.log2(np.maximum(size, 1)))).astype(int)
+        frame = (row_start, col_start, width)
         for k in np.unique(bucket):
             members = np.flatnonzero(bucket == k)
             if k <= 6:
@@ -158,145 +167,23 @@ def trace_panorama(triangles: np.ndarray, width: int, height: int) -> PanoramaHi
                 per = max(1, _BATCH_PIXELS // (side * side))
                 for i0 in range(0, len(members), per):
                     m = members[i0 : i0 + per]
-                    _rasterise(triangles[seen[m]], seen[m], row0[m], side, col0[m], side, dirs, best, out)
+                    _rasterise(triangles[seen[m]], seen[m], row0[m], side, col0[m], side, dirs, frame, best, out)
             else:
                 for m in members:
                     sl = slice(m, m + 1)
                     _rasterise(triangles[seen[sl]], seen[sl], row0[sl], int(nrows[m]), col0[sl], int(ncols[m]),
-                               dirs, best, out)
+                               dirs, frame, best, out)
     distance = np.where(np.isfinite(best), best, 0.0)
     return PanoramaHits(tri=out["tri"], distance=distance, bary=out["bary"], directions=dirs)
 
 
-def _slab(origin: np.ndarray, inv_dir: np.ndarray, lo: np.ndarray, hi: np.ndarray, tmin, tmax) -> np.ndarray:
-    """Segments o + t d, t in [tmin, tmax], against boxes [lo, hi] (broadcasting)."""
-    with np.errstate(invalid="ignore"):
-        t0 = (lo - origin) * inv_dir
-        t1 = (hi - origin) * inv_dir
-    np.nan_to_num(t0, copy=False, nan=-np.inf)
-    np.nan_to_num(t1, copy=False, nan=np.inf)
-    near = np.minimum(t0, t1).max(axis=-1)
-    far = np.maximum(t0, t1).min(axis=-1)
-    return (near <= far) & (far >= tmin) & (near <= tmax)
-
-
-class Occluders:
-    """Triangles that can block light, grouped for fast segment queries.
-
-    Segments stop `_END_GAP` tolerances short of both ends, more than the boxes' margin: a
-    segment ending on a lamp set into a housing then never even enters the housing's box.
-    """
-
-    def __init__(self, triangles: np.ndarray, tri_object: np.ndarray, eps: float) -> None:
-        self.eps = eps
-        self.objects = []
-        for k in np.unique(tri_object):
-            tris = triangles[tri_object == k]
-            centroids = tris.mean(axis=1)
-            lo_o, hi_o = tris.reshape(-1, 3).min(axis=0), tris.reshape(-1, 3).max(axis=0)
-            cells = ((centroids - lo_o) / np.maximum(hi_o - lo_o, 1e-12) * 1023).astype(np.int64)
-            tris = tris[np.argsort(_morton(cells))]
-            n_clusters = -(-len(tris) // _CLUSTER)
-            # Padding repeats the last triangle: a duplicate cannot change "any hit".
-            tris = np.concatenate([tris, np.repeat(tris[-1:], n_clusters * _CLUSTER - len(tris), axis=0)])
-            flat = tris.reshape(n_clusters, _CLUSTER * 3, 3)
-            # Structure of arrays, (9, n_clusters, K): v0, e1, e2 by component, for gathers per cluster.
-            soa = np.concatenate([tris[:, 0], tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0]], axis=1)
-            cluster_lo, cluster_hi = flat.min(axis=1) - eps, flat.max(axis=1) + eps
-            # Groups of _CLUSTER consecutive (Morton-ordered, so nearby) clusters: a third level
-            # keeps a high-poly object from costing every segment a test per cluster.
-            n_groups = -(-n_clusters // _CLUSTER)
-            members = np.arange(n_groups * _CLUSTER)
-            members = np.where(members < n_clusters, members, -1).reshape(n_groups, _CLUSTER)
-            members = members[:, : min(n_clusters, _CLUSTER)]
-            self.objects.append(
-                dict(
-                    lo=lo_o - eps,
-                    hi=hi_o + eps,
-                    glo=np.where(members[..., None] >= 0, cluster_lo[members], np.inf).min(axis=1),
-                    ghi=np.where(members[..., None] >= 0, cluster_hi[members], -np.inf).max(axis=1),
-                    members=members,
-                    clo=cluster_lo,
-                    chi=cluster_hi,
-                    soa=np.ascontiguousarray(soa.T.reshape(9, n_clusters, _CLUSTER)),
-                )
-            )
-
-    def blocked(self, p0: np.ndarray, p1: np.ndarray) -> np.ndarray:
-        """(N,) whether each open segment p0[i] -> p1[i] hits any triangle."""
-        n = len(p0)
-        out = np.zeros(n, dtype=bool)
-        for i0 in range(0, n, _SEG_CHUNK):
-            sl = slice(i0, i0 + _SEG_CHUNK)
-            out[sl] = self._blocked_chunk(np.asarray(p0[sl], dtype=np.float64), np.asarray(p1[sl], dtype=np.float64))
-        return out
-
-    def _blocked_chunk(self, p0: np.ndarray, p1: np.ndarray) -> np.ndarray:
-        d = p1 - p0
-        length = np.linalg.norm(d, axis=1)
-        tmin = np.minimum(_END_GAP * self.eps / np.maximum(length, 1e-300), 0.5)
-        tmax = 1.0 - tmin
-        with np.errstate(divide="ignore"):
-            inv = 1.0 / d
-        out = np.zeros(len(p0), dtype=bool)
-        for obj in self.objects:
-            cand = np.flatnonzero(~out & _slab(p0, inv, obj["lo"], obj["hi"], tmin, tmax))
-            if len(cand) == 0:
-                continue
-            seg, group = _descend(p0, inv, tmin, tmax, cand, obj["glo"], obj["ghi"], None)
-            seg, cluster = _descend(p0, inv, tmin, tmax, seg, obj["clo"], obj["chi"], obj["members"][group])
-            for j0 in range(0, len(seg), _PAIR_CHUNK):
-                s = seg[j0 : j0 + _PAIR_CHUNK]
-                hit = _moller_trumbore(p0[s], d[s], obj["soa"][:, cluster[j0 : j0 + _PAIR_CHUNK]], tmin[s], tmax[s])
-                out[s[hit]] = True
-        return out
-
-
-def _descend(p0, inv, tmin, tmax, seg: np.ndarray, lo: np.ndarray, hi: np.ndarray,
-             children: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
-    """(segment, box) pairs whose boxes the segments `seg` cross, among all boxes (children
-    None) or, per segment, among the box indices children[i] (len(seg), K; -1 for none)."""
-    out_s, out_b = [], []
-    width = len(lo) if children is None else children.shape[1]
-    per = max(1, _PAIR_CHUNK * 4 // max(width, 1))
-    for i0 in range(0, len(seg), per):
-        s = seg[i0 : i0 + per]
-        boxes = np.broadcast_to(np.arange(len(lo)), (len(s), len(lo))) if children is None else children[i0 : i0 + per]
-        hit = _slab(p0[s, None, :], inv[s, None, :], lo[boxes], hi[boxes], tmin[s, None], tmax[s, None]) & (boxes >= 0)
-        r, c = np.nonzero(hit)
-        out_s.append(s[r])
-        out_b.append(boxes[r, c])
-    if not out_s:
-        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
-    return np.concatenate(out_s), np.concatenate(out_b)
-
-
-def _moller_trumbore(o: np.ndarray, d: np.ndarray, tri: np.ndarray, tmin: np.ndarray, tmax: np.ndarray) -> np.ndarray:
-    """(P,) whether segment p hits any of its cluster's K triangles, given by component (9, P, K)."""
-    ox, oy, oz = (o[:, i, None] for i in range(3))
-    dx, dy, dz = (d[:, i, None] for i in range(3))
-    v0x, v0y, v0z, ax, ay, az, bx, by, bz = tri
-    px, py, pz = dy * bz - dz * by, dz * bx - dx * bz, dx * by - dy * bx
-    det = ax * px + ay * py + az * pz
-    ok = np.abs(det) > 1e-20
-    inv = 1.0 / np.where(ok, det, 1.0)
-    tx, ty, tz = ox - v0x, oy - v0y, oz - v0z
-    u = (tx * px + ty * py + tz * pz) * inv
-    qx, qy, qz = ty * az - tz * ay, tz * ax - tx * az, tx * ay - ty * ax
-    v = (dx * qx + dy * qy + dz * qz) * inv
-    t = (bx * qx + by * qy + bz * qz) * inv
-    hit = ok & (u >= 0.0) & (v >= 0.0) & (u + v <= 1.0) & (t > tmin[:, None]) & (t < tmax[:, None])
-    return hit.any(axis=1)
-
-
-def _morton(q: np.ndarray) -> np.ndarray:
-    """Interleave three 10-bit integers per row into one Morton code (spatial sort key)."""
-    code = np.zeros(len(q), dtype=np.int64)
-    for bit in range(10):
-        for axis in range(3):
-            code |= ((q[:, axis] >> bit) & 1) << (3 * bit + axis)
-    return code
-
+def window_directions(width: int, height: int, window: tuple[int, int, int, int]) -> np.ndarray:
+    """(rows, cols, 3) unit directions through the pixel centres of a window (first row, rows,
+    first column, columns) of a W x H panorama; the columns wrap around the seam."""
+    row0, rows, col0, cols = window
+    u = (np.mod(col0 + np.arange(cols), width) + 0.5) / width
+    v = 1.0 - (row0 + np.arange(rows) + 0.5) / height
+    return latlong.uv_to_direction(*np.broadcast_arrays(u[None, :], v[:, None]))
 
 
 def _ray_distances(origins: np.ndarray, directions: np.ndarray, triangles: np.ndarray):

@@ -3,6 +3,12 @@
 Blender's own `Image.save()` colour-manages float images on the way out, so every EXR the
 add-on writes goes through here instead: RGB float32, row 0 at the top, as on disk. PNG is
 only needed for the 8-bit hidden-region mask, so a minimal zlib encoder does.
+
+Panoramas run to 16384 x 8192 (1.6 GB as float32 RGB), so pixels travel in bands of rows:
+a read fills one preallocated float32 array, a write takes its rows from a callable, and
+neither holds more than a band besides the image. Banded access exists only in the binding's
+scanline interface (`InputFile`, `OutputFile`), which sees the first part of a file; the
+`File` interface reads every part whole and is used for a colour part further in.
 """
 from __future__ import annotations
 
@@ -15,61 +21,91 @@ import sys
 import tempfile
 import zlib
 from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+from typing import TypeVar
 
+import Imath
 import numpy as np
 import OpenEXR
 
 from ..errors import DimredError
 
+#: Rows per band: a multiple of the lines one chunk holds under every scanline compression (1,
+#: 16, 32 or 256) and of the usual tile heights, so that no chunk is decoded twice. A band of a
+#: 16384-wide float32 RGB image is 50 MB.
+BAND_ROWS = 256
+
+_FLOAT = Imath.PixelType(Imath.PixelType.FLOAT)
+_ZIP = Imath.Compression(Imath.Compression.ZIP_COMPRESSION)
+# What the library's failures arrive as: the scanline interface raises OSError, the File
+# interface RuntimeError or ValueError.
+_SCANLINE_ERRORS = (OSError,)
+_FILE_ERRORS = (RuntimeError, ValueError, OSError)
+
+_T = TypeVar("_T")
+
+
+@dataclass(frozen=True)
+class _ColourPart:
+    """The part of an EXR file that holds R, G and B: its index and data window."""
+
+    index: int
+    width: int
+    height: int
+    top: int  # the data window's first scanline number
+
+
+def exr_size(path: str | os.PathLike[str]) -> tuple[int, int]:
+    """(width, height) of the image `read_exr` reads from the file, from the headers alone."""
+    part = _colour_part(os.fspath(path))
+    return part.width, part.height
+
 
 def read_exr(path: str | os.PathLike[str]) -> np.ndarray:
     """(H, W, 3) float32 RGB of an EXR file, top row first (alpha and other channels ignored).
 
-    Reads the first part that has R, G and B channels, scanline or tiled, half or float.
+    Reads the first part that has R, G and B channels, scanline or tiled, half or float, into
+    one preallocated array: a band of rows at a time when it is the file's first part (besides
+    the image, one band is held), whole when it is a later one (every part's pixels are held).
     """
     path = os.fspath(path)
-    if not os.path.isfile(path):
-        raise DimredError(f"EXR file not found: {path}")
-    if not OpenEXR.isOpenExrFile(path):
-        raise DimredError(f"not an OpenEXR file: {path}")
-    with _captured_library_messages() as messages:
-        try:
-            parts = OpenEXR.File(path, separate_channels=True).parts
-        except (RuntimeError, ValueError) as exc:
-            parts, failure = [], _library_reason(messages(), exc)
-        else:
-            # A file whose pixel data is cut short or corrupt opens with no parts.
-            failure = _library_reason(messages(), "no readable image data")
-    if not parts:
-        raise DimredError(f"cannot read EXR file {path}: {failure}")
-    found: list[str] = []
-    for part in parts:
-        channels = part.channels
-        found.extend(channels)
-        if all(name in channels for name in "RGB"):
-            planes = [channels[name] for name in "RGB"]
-            if any(c.xSampling != 1 or c.ySampling != 1 for c in planes):
-                raise DimredError(f"EXR file {path} has subsampled colour channels, which are not supported")
-            return np.stack([c.pixels for c in planes], axis=-1).astype(np.float32)
-    listed = ", ".join(sorted(set(found))) or "none"
-    raise DimredError(f"EXR file {path} has no R, G, B channels (channels: {listed})")
+    part = _colour_part(path)
+    rgb = np.empty((part.height, part.width, 3), np.float32)
+    if part.index == 0:
+        _library_call(path, "read", lambda: _read_bands(path, part, rgb), _SCANLINE_ERRORS)
+    else:
+        _library_call(path, "read", lambda: _read_whole(path, part, rgb), _FILE_ERRORS)
+    return rgb
 
 
 def write_exr(path: str | os.PathLike[str], image: np.ndarray) -> None:
-    """Write (H, W, 3) RGB as a float32 ZIP-compressed scanline EXR, top row first, atomically."""
+    """Write (H, W, 3) RGB as a float32 ZIP-compressed scanline EXR, top row first, atomically.
+
+    Rows are converted to float32 a band at a time: no full-size copy is made.
+    """
     rgb = np.asarray(image)
     if rgb.ndim != 3 or rgb.shape[2] != 3:
         raise ValueError(f"write_exr expects an (H, W, 3) array, got shape {rgb.shape}")
-    rgb = rgb.astype(np.float32)
-    channels = {name: np.ascontiguousarray(rgb[..., i]) for i, name in enumerate("RGB")}
-    header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}
+    write_exr_rows(path, rgb.shape[0], rgb.shape[1], lambda start, stop: rgb[start:stop])
+
+
+def write_exr_rows(path: str | os.PathLike[str], height: int, width: int,
+                   rows: Callable[[int, int], np.ndarray]) -> None:
+    """Write a `height` x `width` image as `write_exr` does, taking its pixels from
+    `rows(start, stop)`: the (stop - start, width, 3) band of rows start:stop.
+
+    Bands are asked for once each, top first, and only one is held at a time, so the whole
+    image need never exist (`RemovalResult.edited_rows`). An exception from `rows` ends the
+    write and leaves no file behind.
+    """
+    if height < 1 or width < 1:
+        raise ValueError(f"write_exr_rows expects a positive size, got {width}x{height}")
+    header = OpenEXR.Header(int(width), int(height))  # R, G, B float32, rows top first
+    header["compression"] = _ZIP
 
     def write(temp_path: str) -> None:
-        with _captured_library_messages() as messages:
-            try:
-                OpenEXR.File(header, channels).write(temp_path)
-            except (RuntimeError, ValueError, OSError) as exc:
-                raise DimredError(f"cannot write EXR file {path}: {_library_reason(messages(), exc)}") from None
+        _library_call(path, "write", lambda: _write_bands(temp_path, header, height, width, rows), _SCANLINE_ERRORS)
+        _library_call(path, "write", lambda: _check_complete(path, temp_path, height), _SCANLINE_ERRORS)
 
     _write_atomically(os.fspath(path), write)
 
@@ -128,6 +164,109 @@ def _write_atomically(path: str, write: Callable[[str], None]) -> None:
 def _remove_quietly(path: str) -> None:
     with contextlib.suppress(FileNotFoundError):
         os.unlink(path)
+
+
+def _colour_part(path: str) -> _ColourPart:
+    """Which part `read_exr` reads and its size, from the file's headers."""
+    if not os.path.isfile(path):
+        raise DimredError(f"EXR file not found: {path}")
+    if not OpenEXR.isOpenExrFile(path):
+        raise DimredError(f"not an OpenEXR file: {path}")
+    found: list[str] = []
+    for index, header in enumerate(_library_call(path, "read", lambda: _headers(path), _FILE_ERRORS)):
+        channels = {channel.name: channel for channel in header["channels"]}
+        found.extend(channels)
+        if all(name in channels for name in "RGB"):
+            if any(channels[name].xSampling != 1 or channels[name].ySampling != 1 for name in "RGB"):
+                raise DimredError(f"EXR file {path} has subsampled colour channels, which are not supported")
+            (left, top), (right, bottom) = header["dataWindow"]
+            return _ColourPart(index, int(right - left + 1), int(bottom - top + 1), int(top))
+    listed = ", ".join(sorted(set(found))) or "none"
+    raise DimredError(f"EXR file {path} has no R, G, B channels (channels: {listed})")
+
+
+def _headers(path: str) -> list[dict]:
+    parts = OpenEXR.File(path, header_only=True).parts
+    if not parts:
+        raise RuntimeError("no readable image data")
+    return [part.header for part in parts]
+
+
+def _read_bands(path: str, part: _ColourPart, rgb: np.ndarray) -> None:
+    """Fill `rgb` from the file's first part, converted to float32 by the library, band by band."""
+    source = OpenEXR.InputFile(path)
+    try:
+        for start, stop in _bands(part.height):
+            _read_band(source, part, rgb[start:stop], part.top + start)
+    finally:
+        source.close()
+
+
+def _read_band(source: OpenEXR.InputFile, part: _ColourPart, band: np.ndarray, first: int) -> None:
+    # A function of its own so that a band's planes are freed before the next band's are read.
+    planes = source.channels(["R", "G", "B"], _FLOAT, first, first + len(band) - 1)
+    for i, plane in enumerate(planes):
+        band[..., i] = np.frombuffer(plane, np.float32).reshape(len(band), part.width)
+
+
+def _read_whole(path: str, part: _ColourPart, rgb: np.ndarray) -> None:
+    """Fill `rgb` from a later part, which only the File interface reaches (it reads all parts)."""
+    parts = OpenEXR.File(path, separate_channels=True).parts
+    if len(parts) <= part.index:
+        # A file whose pixel data is cut short or corrupt opens with no parts.
+        raise RuntimeError("no readable image data")
+    channels = parts[part.index].channels
+    for i, name in enumerate("RGB"):
+        rgb[..., i] = channels[name].pixels
+
+
+def _write_bands(path: str, header: dict, height: int, width: int, rows: Callable[[int, int], np.ndarray]) -> None:
+    target = OpenEXR.OutputFile(path, header)
+    try:
+        for start, stop in _bands(height):
+            target.writePixels(_planes(rows, start, stop, width), stop - start)
+    finally:
+        target.close()
+
+
+def _planes(rows: Callable[[int, int], np.ndarray], start: int, stop: int, width: int) -> dict[str, np.ndarray]:
+    """The R, G and B planes of rows(start, stop), contiguous float32 as the library takes them."""
+    band = np.asarray(rows(start, stop))
+    if band.shape != (stop - start, width, 3):
+        raise ValueError(f"rows({start}, {stop}) gave an array of shape {band.shape}, not {(stop - start, width, 3)}")
+    return {name: np.ascontiguousarray(band[..., i], dtype=np.float32) for i, name in enumerate("RGB")}
+
+
+def _check_complete(path: str, temp_path: str, height: int) -> None:
+    """DimredError unless the written file's bottom row reads back.
+
+    The library writes the chunk offsets and the last buffered bytes as it closes the file, and
+    drops any failure there (a disk that fills up at the end). The bottom rows are the last
+    chunk written, so a file cut short fails to give them.
+    """
+    written = OpenEXR.InputFile(temp_path)
+    try:
+        written.channels(["R"], _FLOAT, height - 1, height - 1)
+    except OSError:
+        raise DimredError(f"cannot write EXR file {path}: the file on disk is incomplete (is the disk full?)") from None
+    finally:
+        written.close()
+
+
+def _bands(height: int) -> Iterator[tuple[int, int]]:
+    for start in range(0, height, BAND_ROWS):
+        yield start, min(start + BAND_ROWS, height)
+
+
+def _library_call(path: str, verb: str, call: Callable[[], _T], errors: tuple[type[Exception], ...]) -> _T:
+    """call(), its failures of type `errors` turned into one DimredError line naming `path`."""
+    with _captured_library_messages() as messages:
+        try:
+            return call()
+        except errors as exc:
+            reason = _library_reason(messages(), exc)
+    raise DimredError(f"cannot {verb} EXR file {path}: {reason}")
+
 
 
 @contextlib.contextmanager

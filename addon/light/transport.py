@@ -17,7 +17,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..geometry.raycast import Occluders
+from ..geometry.occluders import Occluders
 from .formfactor import point_to_triangle
 
 _SEGMENTS_PER_CHUNK = 300_000

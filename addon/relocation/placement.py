@@ -10,7 +10,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import DimredError
-from ..geometry.raycast import Occluders, crossings, first_hits
+from ..geometry.occluders import Occluders
+from ..geometry.raycast import crossings, first_hits
 from ..scene import SceneData
 from . import fixedview
 from .fixedview import Move

@@ -10,25 +10,36 @@ from .solution import Solution
 
 
 def compose(solution: Solution, rep: Report) -> np.ndarray:
-    """(N, 3) radiance change of the hit pixels (0 where the pixel is filled or shows a light).
-
-    Where E is ~0 the ratio means nothing and the pixel is left; where the pixel implies a
-    reflectance above RHO_MAX, E is taken as large as that bound allows (a lamp's glare or a
-    model error would otherwise turn into a huge relative change); a change that would make
-    the radiance negative is clamped to black."""
-    traced, e_h, de_h = solution.traced, solution.e_h, solution.de_h
-    radiance = traced.panorama_rows(solution.hdri)
+    """(N, 3) radiance change of the hit pixels (0 where the pixel is filled or shows a light)."""
+    traced, e_h = solution.traced, solution.e_h
     apply = ~traced.hidden_h & ~solution.room.pixels.emitter_h
-    e_ref = float(np.median(e_h[apply] @ LUMA)) if apply.any() else 0.0
-    dark = (e_h @ LUMA) <= 1e-6 * max(e_ref, 1e-30)
-    rep.guard("irradiance_near_zero_pixels", int((apply & dark & (np.abs(de_h) @ LUMA > 0)).sum()))
-    apply &= ~dark
-    e = np.maximum(e_h, 1e-30)
+    return ratio_change(traced.panorama_rows(solution.hdri), e_h, solution.de_h, apply,
+                        e_ref=reference_irradiance(e_h, apply), rep=rep)
+
+
+def reference_irradiance(e: np.ndarray, apply: np.ndarray) -> float:
+    """The median luminance of E over the pixels that are relit: what "E is ~0" is relative to."""
+    return float(np.median(e[apply] @ LUMA)) if apply.any() else 0.0
+
+
+def ratio_change(radiance: np.ndarray, e: np.ndarray, de: np.ndarray, apply: np.ndarray, *, e_ref: float,
+                 rep: Report) -> np.ndarray:
+    """(N, 3) change of the radiance (N, 3) of pixels with irradiance E and change dE (N, 3)
+    where `apply`, else 0.
+
+    Where E is ~0 (against `e_ref`) the ratio means nothing and the pixel is left; where the
+    pixel implies a reflectance above RHO_MAX, E is taken as large as that bound allows (a
+    lamp's glare or a model error would otherwise turn into a huge relative change); a change
+    that would make the radiance negative is clamped to black."""
+    dark = (e @ LUMA) <= 1e-6 * max(e_ref, 1e-30)
+    rep.guard("irradiance_near_zero_pixels", int((apply & dark & (np.abs(de) @ LUMA > 0)).sum()))
+    apply = apply & ~dark
+    e = np.maximum(e, 1e-30)
     implied = np.pi * radiance / e
     over = implied > RHO_MAX
     rep.guard("reflectance_clamped_pixels", int((apply & over.any(axis=1)).sum()))
     e_eff = np.where(over, np.pi * radiance / RHO_MAX, e)
-    d = np.where(apply[:, None], radiance * de_h / np.maximum(e_eff, 1e-30), 0.0)
+    d = np.where(apply[:, None], radiance * de / np.maximum(e_eff, 1e-30), 0.0)
     negative = radiance + d < 0.0
     rep.guard("negative_radiance_clamped", int(negative.any(axis=1).sum()))
     return np.where(negative, -radiance, d)

@@ -9,6 +9,7 @@ import numpy as np
 
 from ..callbacks import RunCallbacks
 from ..geometry import latlong
+from ..geometry.mesh import Geometry
 from ..geometry.planeraster import edge_direction
 from ..light.radiosity import LUMA, RHO_MAX
 from ..report import Report
@@ -21,59 +22,59 @@ from .solution import Solution
 
 
 @dataclass(frozen=True)
-class _Revealed:
-    """The revealed pixels' light: irradiance after removal, patch, and radiance as photographed."""
+class Revealed:
+    """The pixels to fill (those that saw the object and see a surface once it is gone), at
+    the resolution they are filled at, and the panorama's reflectance around them."""
 
-    e_after: np.ndarray  # (K, 3)
-    patch: np.ndarray  # (K,)
-    radiance: np.ndarray  # (K, 3)
+    tri: np.ndarray  # (K,) the triangle each sees without the object
+    bary: np.ndarray  # (K, 2) barycentric weights of its vertices 1 and 2 there
+    points: np.ndarray  # (K, 3) the point it sees
+    radiance: np.ndarray  # (K, 3) as photographed
+    footprint: np.ndarray  # (K,) the pixel's edge projected on that surface
+    panorama: PanoramaReflectance  # the exemplar's source
 
 
-def fill_hidden(solution: Solution, rep: Report, callbacks: RunCallbacks,
+def fill_hidden(solution: Solution, revealed: Revealed, rep: Report, callbacks: RunCallbacks,
                 show: Callable[[np.ndarray], None] | None = None) -> np.ndarray:
-    """(K, 3) radiance change of the revealed pixels (those that saw the object and see a
-    surface once it is gone): synthesised reflectance lit by the irradiance after removal.
+    """(K, 3) radiance change of the revealed pixels: synthesised reflectance lit by the
+    irradiance after removal.
 
     `show(change)` gets the revealed pixels' change as the fill refines: first with each
     patch's mean reflectance, then after every synthesis level of every surface."""
-    geo, room, traced = solution.geo, solution.room, solution.traced
-    behind = traced.behind
-    radiance = traced.panorama_rows(solution.hdri)
-    lit = _revealed_light(solution, radiance, callbacks)
+    geo, room = solution.geo, solution.room
+    fine = fine_light(geo, solution.target, room, solution.occlusion, solution.db, solution.split, revealed.tri,
+                      revealed.bary, callbacks)
+    patch, _, _ = room.patches.lattice.locate(revealed.tri, revealed.bary)
+    e_after = np.maximum(interpolate(fine.e_after, fine.corners, fine.weights), 0.0)
     b = room.senders.radiosity
-    rho = room.rho[lit.patch].copy()
-    emit = room.emitter[lit.patch]
+    rho = room.rho[patch].copy()
+    emit = room.emitter[patch]
 
     def change() -> np.ndarray:
-        new = rho * lit.e_after / np.pi
+        new = rho * e_after / np.pi
         # A light behind the object shines on with the radiosity its patch was given.
-        new[emit] = b[lit.patch[emit]] / np.pi
-        return new - lit.radiance
+        new[emit] = b[patch[emit]] / np.pi
+        return new - revealed.radiance
 
     if show is not None:
         show(change())
-    panorama = _panorama_reflectance(solution, radiance)
-    options = FillOptions(cell=_raster_cell(solution), margin=solution.params.exemplar_margin,
+    options = FillOptions(cell=float(np.median(revealed.footprint)) * solution.params.raster_cell,
+                          margin=solution.params.exemplar_margin,
                           synthesis=SynthesisParams(neighbourhood=solution.params.synth_neighbourhood,
                                                     levels=solution.params.synth_levels,
                                                     generations=solution.params.synth_generations),
                           seed=solution.params.seed)
-    keys = solution.target.surface_key
     surfaces = []
-    for key in np.unique(keys[behind.tri]):
-        sel = np.flatnonzero(keys[behind.tri] == key)
+    for sel, plane in hidden_planes(geo, solution.target.surface_key, revealed.tri, revealed.points):
         callbacks.check()
 
         def level_shown(level_rho: np.ndarray, sel: np.ndarray = sel) -> None:
             rho[sel] = level_rho
             show(change())
 
-        normal = geo.normals[behind.tri[sel[0]]]
-        plane = HiddenPlane(surface=int(key), normal=normal, points=behind.points[sel],
-                            along=edge_direction(geo.triangles[keys == key], normal))
-        got = fill_surface(panorama, plane, options, cancel=callbacks.cancel,
+        got = fill_surface(revealed.panorama, plane, options, cancel=callbacks.cancel,
                            progress=None if show is None else level_shown)
-        name = geo.object_names[geo.tri_object[behind.tri[sel[0]]]]
+        name = geo.object_names[geo.tri_object[revealed.tri[sel[0]]]]
         if got.known_cells:
             rho[sel] = got.rho
         if not got.synthesised:
@@ -86,14 +87,43 @@ def fill_hidden(solution: Solution, rep: Report, callbacks: RunCallbacks,
     return change()
 
 
-def _revealed_light(solution: Solution, radiance: np.ndarray, callbacks: RunCallbacks) -> _Revealed:
-    """The light of the revealed pixels, given every hit pixel's photographed radiance (N, 3)."""
-    behind = solution.traced.behind
-    fine = fine_light(solution.geo, solution.target, solution.room, solution.occlusion, solution.db,
-                      solution.split, behind.tri, behind.bary, callbacks)
-    patch, _, _ = solution.room.patches.lattice.locate(behind.tri, behind.bary)
-    e_after = np.maximum(interpolate(fine.e_after, fine.corners, fine.weights), 0.0)
-    return _Revealed(e_after, patch, radiance[behind.revealed])
+def hidden_planes(geo: Geometry, keys: np.ndarray, tri: np.ndarray, points: np.ndarray
+                  ) -> list[tuple[np.ndarray, HiddenPlane]]:
+    """The planes the revealed points (triangles `tri`, points (K, 3)) lie on, by surface
+    key: which of the points each holds and the plane to synthesise."""
+    planes = []
+    for key in np.unique(keys[tri]):
+        sel = np.flatnonzero(keys[tri] == key)
+        normal = geo.normals[tri[sel[0]]]
+        planes.append((sel, HiddenPlane(surface=int(key), normal=normal, points=points[sel],
+                                        along=edge_direction(geo.triangles[keys == key], normal))))
+    return planes
+
+
+def working_revealed(solution: Solution) -> Revealed:
+    """The revealed pixels of the working panorama, with its whole reflectance as exemplar."""
+    traced, behind = solution.traced, solution.traced.behind
+    radiance = traced.panorama_rows(solution.hdri)
+    pix = traced.hp[behind.revealed]
+    solid = np.broadcast_to(latlong.pixel_solid_angles(traced.width, traced.height),
+                            (traced.height, traced.width)).ravel()[pix]
+    footprint = surface_footprint(solid, traced.hits.directions.reshape(-1, 3)[pix],
+                                  solution.geo.normals[behind.tri], behind.distance_without[pix])
+    return Revealed(tri=behind.tri, bary=behind.bary, points=behind.points, radiance=radiance[behind.revealed],
+                    footprint=footprint, panorama=_panorama_reflectance(solution, radiance))
+
+
+def surface_footprint(solid: np.ndarray, directions: np.ndarray, normals: np.ndarray, distance: np.ndarray
+                      ) -> np.ndarray:
+    """(K,) the edge of pixels of solid angle `solid` projected at `distance` along their unit
+    `directions` onto surfaces with those `normals`."""
+    cos = np.abs(np.einsum("ij,ij->i", directions, normals))
+    return np.sqrt(solid * distance**2 / np.maximum(cos, MIN_COS))
+
+
+def measured_reflectance(radiance: np.ndarray, e: np.ndarray, measured: np.ndarray) -> np.ndarray:
+    """(N, 3) rho = pi L / E where `measured`, else 0, clipped to the physical range."""
+    return np.where(measured[:, None], np.clip(np.pi * radiance / np.maximum(e, 1e-30), 0.0, RHO_MAX), 0.0)
 
 
 def _panorama_reflectance(solution: Solution, radiance: np.ndarray) -> PanoramaReflectance:
@@ -113,18 +143,7 @@ def _panorama_reflectance(solution: Solution, radiance: np.ndarray) -> PanoramaR
     e_ref = float(np.median(e_h @ LUMA))
     measured = ~traced.hidden_h & ~room.pixels.emitter_h & ((e_h @ LUMA) > 1e-3 * e_ref)
     rho = np.zeros((n, 3))
-    rho[traced.hp[measured]] = np.clip(np.pi * radiance[measured] / e_h[measured], 0.0, RHO_MAX)
+    rho[traced.hp] = measured_reflectance(radiance, e_h, measured)
     valid = np.zeros(n, dtype=bool)
     valid[traced.hp[measured]] = True
     return PanoramaReflectance(rho.reshape(*shape, 3), valid.reshape(shape), maps)
-
-
-def _raster_cell(solution: Solution) -> float:
-    """Raster cells about as large as the panorama's pixels where the object was."""
-    traced, behind = solution.traced, solution.traced.behind
-    width, height = traced.width, traced.height
-    pix = traced.hp[behind.revealed]
-    solid = np.broadcast_to(latlong.pixel_solid_angles(width, height), (height, width)).ravel()[pix]
-    cos = np.abs(np.einsum("ij,ij->i", traced.hits.directions.reshape(-1, 3)[pix], solution.geo.normals[behind.tri]))
-    footprint = np.sqrt(solid * behind.distance_without[pix] ** 2 / np.maximum(cos, MIN_COS))
-    return float(np.median(footprint)) * solution.params.raster_cell

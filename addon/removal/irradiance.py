@@ -49,8 +49,22 @@ def fine_light(geo: Geometry, target: Target, room: Room, occlusion: Occlusion, 
     needed, inverse = np.unique(corners, return_inverse=True)
     callbacks.check()
     points = inset(fine.vertices[needed], geo.triangles[fine.vertex_tri[needed]])
-    normals = geo.normals[fine.vertex_tri[needed]]
+    return _light_of(points, geo.normals[fine.vertex_tri[needed]], room, occlusion, db, split,
+                     inverse.reshape(corners.shape), weights, callbacks)
+
+
+def point_light(points: np.ndarray, normals: np.ndarray, room: Room, occlusion: Occlusion, db: np.ndarray,
+                split: Split, callbacks: RunCallbacks) -> FineLight:
+    """Light at the points (N, 3) themselves, each its own vertex: for the few pixels where
+    even a fine lattice would blur what they show (beside the object's silhouette)."""
+    n = len(points)
+    return _light_of(points, normals, room, occlusion, db, split, np.repeat(np.arange(n)[:, None], 3, axis=1),
+                     np.repeat([[1.0, 0.0, 0.0]], n, axis=0), callbacks)
+
+
+def _light_of(points: np.ndarray, normals: np.ndarray, room: Room, occlusion: Occlusion, db: np.ndarray,
+              split: Split, corners: np.ndarray, weights: np.ndarray, callbacks: RunCallbacks) -> FineLight:
     t_with, t_without = occlusion.transport(points, normals, room.senders, callbacks)
     e, e_after = before_and_after(room, db, split, t_with, t_without,
                                   *occlusion.transport(points, normals, split.senders, callbacks))
-    return FineLight(t_with, t_without, e, e_after, inverse.reshape(corners.shape), weights)
+    return FineLight(t_with, t_without, e, e_after, corners, weights)

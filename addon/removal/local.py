@@ -11,11 +11,12 @@ from ..callbacks import RunCallbacks
 from ..geometry.mesh import Geometry
 from ..light.formfactor import paired_point_to_triangle
 from ..light.planner import neighbourhood
+from ..light.split import Split
 from ..light.transport import pair_visibility
 from ..quality import Params
 from ..report import Report
 from .interpolation import interpolate
-from .irradiance import before_and_after, fine_light
+from .irradiance import before_and_after, fine_light, point_light
 from .occlusion import Occlusion
 from .propagation import Propagation
 from .room import Room
@@ -26,20 +27,72 @@ from .trace import Traced
 
 @dataclass(frozen=True)
 class LocalLight:
-    """Per hit pixel: E (N, 3) with the object in place, and dE (N, 3) with every bounce of
-    the change once it is gone."""
+    """Per receiving point: E (N, 3) with the object in place, and dE (N, 3) with every
+    bounce of the change once it is gone."""
 
     e_h: np.ndarray
     de_h: np.ndarray
 
 
+@dataclass(frozen=True)
+class Receiving:
+    """Surface points whose light is wanted: the hit pixels of the working panorama, or the
+    full-resolution pixels the upsampling cannot serve."""
+
+    points: np.ndarray  # (N, 3) probe frame
+    normals: np.ndarray  # (N, 3)
+    tri: np.ndarray  # (N,) geometry triangle
+    bary: np.ndarray  # (N, 2) barycentric weights of its vertices 1 and 2
+    corners: np.ndarray  # (N, 3) receiver rows of the coarse lattice vertices each interpolates
+    weights: np.ndarray  # (N, 3) their weights
+    relit: np.ndarray  # (N,) bool: may change (not hidden, not a light, on a relit plane)
+
+
+def traced_receiving(traced: Traced, room: Room, target: Target) -> Receiving:
+    """The working panorama's hit pixels as receivers."""
+    relit = ~traced.hidden_h & ~room.pixels.emitter_h
+    if target.planes:
+        relit &= np.isin(traced.obj_h, target.planes)
+    return Receiving(points=traced.points_h, normals=traced.normals_h, tri=traced.tri_h,
+                     bary=traced.hits.bary.reshape(-1, 2)[traced.hp], corners=room.pixels.corners_h,
+                     weights=room.pixels.weights_h, relit=relit)
+
+
 def local_light(geo: Geometry, target: Target, traced: Traced, occlusion: Occlusion, room: Room,
                 propagation: Propagation, params: Params, rep: Report, callbacks: RunCallbacks) -> LocalLight:
     """Per-pixel E and dE after removal, exact where the object's shadow of a light falls."""
-    db, split = propagation.db, propagation.split
+    light = light_at(geo, target, traced_receiving(traced, room, target), occlusion, room, propagation.db,
+                     propagation.split, params, callbacks)
+    rep.info["affected_pixels"] = light.affected
+    if light.affected == 0:
+        rep.skip("local", "the object neither shadows nor lights any visible surface")
+    else:
+        rep.info["fine_vertices"] = light.fine_vertices
+        rep.info["exact_pairs"] = light.exact_pairs
+    return LocalLight(light.e, light.de)
+
+
+@dataclass(frozen=True)
+class PointLight:
+    """E and dE (N, 3) at receiving points, and what it took: the points the object affects,
+    the fine lattice's vertices and the (point, sender) pairs given exact visibility."""
+
+    e: np.ndarray
+    de: np.ndarray
+    affected: int
+    fine_vertices: int
+    exact_pairs: int
+
+
+def light_at(geo: Geometry, target: Target, receiving: Receiving, occlusion: Occlusion, room: Room, db: np.ndarray,
+             split: Split, params: Params, callbacks: RunCallbacks, *, per_point: bool = False) -> PointLight:
+    """E and dE at the receiving points, exact where the object's shadow of a light falls,
+    given the change db (P, 3) of the patches with every bounce and the split patches. Near
+    the object the light comes from a fine lattice, or with `per_point` from each point's own
+    transport."""
     b = room.senders.radiosity
     imp = np.flatnonzero(room.important)
-    corners_h, weights_h = room.pixels.corners_h, room.pixels.weights_h
+    corners_h, weights_h = receiving.corners, receiving.weights
 
     # The important senders' change is added per pixel below, exactly where it matters.
     def change(e: np.ndarray, e_after: np.ndarray, t: np.ndarray, t_w: np.ndarray) -> np.ndarray:
@@ -49,16 +102,12 @@ def local_light(geo: Geometry, target: Target, traced: Traced, occlusion: Occlus
     e_h = interpolate(e_v, corners_h, weights_h)
     de_h = interpolate(change(e_v, ea_v, room.t_with, room.t_without), corners_h, weights_h)
 
-    candidates = ~traced.hidden_h & ~room.pixels.emitter_h
-    if target.planes:
-        candidates &= np.isin(traced.obj_h, target.planes)
-    candidate = np.flatnonzero(candidates)  # rows of the hit pixels that may be relit
-    sig = significant(room.senders, imp, traced.points_h[candidate], e_h[candidate], target, params)
-    near = neighbourhood(traced.points_h[candidate], target.centre, target.radius, reach=params.reach)
-    rep.info["affected_pixels"] = int((sig.any(axis=1) | near).sum())
+    candidate = np.flatnonzero(receiving.relit)  # the points that may be relit
+    sig = significant(room.senders, imp, receiving.points[candidate], e_h[candidate], target, params)
+    near = neighbourhood(receiving.points[candidate], target.centre, target.radius, reach=params.reach)
+    affected = int((sig.any(axis=1) | near).sum())
     if not (sig.any() or near.any()):
-        rep.skip("local", "the object neither shadows nor lights any visible surface")
-        return LocalLight(e_h, de_h)
+        return PointLight(e_h, de_h, affected, 0, 0)
 
     # Base for the pixel: the coarse lattice, or near the object a fine one (only the
     # vertices the pixels use): the split patches' sub-triangles beside the object light
@@ -68,31 +117,34 @@ def local_light(geo: Geometry, target: Target, traced: Traced, occlusion: Occlus
     pix = candidate[pair_row]
     lattice_e = (weights_h[pix] * room.t_with[corners_h[pix], s[:, None]]).sum(axis=1)
     near_pixels = candidate[near]
+    fine_vertices = 0
     if len(near_pixels):
-        fine = fine_light(geo, target, room, occlusion, db, split, traced.tri_h[near_pixels],
-                          traced.hits.bary.reshape(-1, 2)[traced.hp[near_pixels]], callbacks)
-        rep.info["fine_vertices"] = len(fine.t_with)
+        fine = (point_light(receiving.points[near_pixels], receiving.normals[near_pixels], room, occlusion, db,
+                            split, callbacks) if per_point else
+                fine_light(geo, target, room, occlusion, db, split, receiving.tri[near_pixels],
+                           receiving.bary[near_pixels], callbacks))
+        fine_vertices = len(fine.t_with)
         e_h[near_pixels] = interpolate(fine.e, fine.corners, fine.weights)
         de_h[near_pixels] = interpolate(change(fine.e, fine.e_after, fine.t_with, fine.t_without), fine.corners,
-                               fine.weights)
-        row = np.full(len(traced.hp), -1)
+                                        fine.weights)
+        row = np.full(len(receiving.points), -1)
         row[near_pixels] = np.arange(len(near_pixels))
         in_fine = row[pix] >= 0
         k = row[pix[in_fine]]
         lattice_e[in_fine] = (fine.weights[k] * fine.t_with[fine.corners[k], s[in_fine, None]]).sum(axis=1)
-    _add_exact_shadows(e_h, de_h, traced, occlusion, room, pix, s, lattice_e, callbacks)
-    rep.info["exact_pairs"] = len(s)
-    return LocalLight(e_h, de_h)
+    _add_exact_shadows(e_h, de_h, receiving, occlusion, room, pix, s, lattice_e, callbacks)
+    return PointLight(e_h, de_h, affected, fine_vertices, len(s))
 
 
-def _add_exact_shadows(e_h: np.ndarray, de_h: np.ndarray, traced: Traced, occlusion: Occlusion, room: Room,
+def _add_exact_shadows(e_h: np.ndarray, de_h: np.ndarray, receiving: Receiving, occlusion: Occlusion, room: Room,
                        pix: np.ndarray, s: np.ndarray, lattice_e: np.ndarray, callbacks: RunCallbacks) -> None:
     """Replace, in the arrays being built, the lattice's share `lattice_e` of the pairs (pixel
     pix, important sender s) by exact form factors and sampled visibility."""
     b = room.senders.radiosity
     senders = room.senders
-    f = paired_point_to_triangle(traced.points_h[pix], traced.normals_h[pix], senders.triangles[s], senders.normals[s])
-    vis, vis_w = pair_visibility(traced.points_h, senders, pix, s, occlusion.removed, occlusion.others,
+    f = paired_point_to_triangle(receiving.points[pix], receiving.normals[pix], senders.triangles[s],
+                                 senders.normals[s])
+    vis, vis_w = pair_visibility(receiving.points, senders, pix, s, occlusion.removed, occlusion.others,
                                  callbacks.check)
     np.add.at(e_h, pix, (f * vis - lattice_e)[:, None] * b[s])
     np.add.at(de_h, pix, (f * (vis_w - vis))[:, None] * b[s])

@@ -8,7 +8,7 @@ import numpy as np
 
 from ..callbacks import RunCallbacks
 from ..geometry.mesh import Geometry, boundary_objects
-from ..geometry.raycast import Occluders
+from ..geometry.occluders import Occluders
 from ..light.transport import Senders, transport
 from ..report import Report
 from .target import Target

@@ -10,7 +10,7 @@ panorama between the trace and the light.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -20,8 +20,9 @@ from ..quality import Params
 from ..report import Report
 from ..scene import SceneData
 from .compose import compose
-from .fill import fill_hidden
+from .fill import fill_hidden, working_revealed
 from .first_order import first_order
+from .full_resolution import full_resolution
 from .local import local_light
 from .occlusion import occluders
 from .propagation import propagate_change
@@ -29,6 +30,7 @@ from .room import solve_room
 from .solution import Solution
 from .target import Target, prepare
 from .trace import Traced, trace
+from .working import downsample, working_size
 
 STAGES = 8  # the stages a removal reports progress for
 
@@ -102,14 +104,12 @@ def finish(solution: Solution, rep: Report, callbacks: RunCallbacks = NO_CALLBAC
     def difference_image(d_revealed: np.ndarray) -> np.ndarray:
         d = d_h.copy()
         d[revealed] = d_revealed
-        image = np.zeros((traced.height * traced.width, 3), dtype=np.float32)
-        image[traced.hp] = d
-        return image.reshape(traced.height, traced.width, 3)
+        return _difference_image(traced, d)
 
     if len(revealed):
         show = None if callbacks.preview is None else lambda d_revealed: callbacks.show(difference_image(d_revealed))
         with rep.stage("synthesis"):
-            d_revealed = fill_hidden(solution, rep, callbacks, show)
+            d_revealed = fill_hidden(solution, working_revealed(solution), rep, callbacks, show)
     else:
         d_revealed = np.zeros((0, 3))
         rep.skip("synthesis", "the object is not visible from the probe centre: no hidden region to fill"
@@ -127,5 +127,26 @@ def remove(scene: SceneData, object_name: str, *, planes: list[str] | tuple[str,
     `callbacks.preview(difference)` gets (H, W, 3) float32 difference images before the
     result: the lighting corrected with the hidden region roughly filled, then refined level
     by level."""
-    rep = Report(callbacks.progress, stages=STAGES)
-    return finish(solve(scene, object_name, planes, params or Params(), rep, callbacks), rep, callbacks)
+    params = params or Params()
+    height, width = scene.hdri.shape[:2]
+    size = working_size(width, height, max_width=params.working_width)
+    rep = Report(callbacks.progress, stages=STAGES + (size != (width, height)))
+    if size == (width, height):
+        return finish(solve(scene, object_name, planes, params, rep, callbacks), rep, callbacks)
+    rep.info["working_resolution"] = list(size)
+    with rep.stage("downsample"):
+        working = replace(scene, hdri=downsample(scene.hdri, *size))
+    solution = solve(working, object_name, planes, params, rep, callbacks)
+    if callbacks.preview is not None:
+        callbacks.show(_difference_image(solution.traced, compose(solution, Report())))
+    full = full_resolution(solution, scene.hdri, rep, callbacks)
+    rep.info["hidden_region_filled"] = full.filled
+    return RemovalResult(difference=full.difference, hidden_mask=full.hidden_mask, report=rep.as_dict(),
+                         hdri=scene.hdri)
+
+
+def _difference_image(traced: Traced, d_h: np.ndarray) -> np.ndarray:
+    """(H, W, 3) float32 image of a change (N, 3) of the hit pixels."""
+    image = np.zeros((traced.height * traced.width, 3), dtype=np.float32)
+    image[traced.hp] = d_h
+    return image.reshape(traced.height, traced.width, 3)

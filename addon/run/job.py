@@ -1,14 +1,18 @@
-"""One removal (or relocation) as the Blender operator runs it: plain data in, staged files out
-(no bpy).
+"""One removal (or relocation) as the Blender operator runs it: plain data in, staged files and
+previews out (no bpy).
 
 The operator gathers a `RemovalRequest` on the main thread and runs `run` either in a worker
 thread or, in background mode, directly. A request with a `move` relocates the object (removal
 at the photographed place, insertion at the moved one) and is otherwise handled the same.
-Removals compose: the request carries the difference of the objects removed before (`base`),
+Removals compose: the request names the differences of the objects removed before (`base`),
 the engine works on HDRI + base, and the world layer shows base + this run's difference. Files
 are written under temporary names next to their final paths and only `Staged.commit` (on the
 main thread, once the run is accepted) renames them into place, so a cancelled or failed run
 leaves earlier results as they were.
+
+Previews are small whatever the panorama's size (`preview`), so showing one costs the main
+thread milliseconds. The first comes from small copies of the input files before the panorama
+itself is read (`quick_preview`), the next ones are the engine's, resampled here in the worker.
 """
 from __future__ import annotations
 
@@ -22,11 +26,16 @@ import numpy as np
 
 from ..callbacks import NO_CALLBACKS, RunCallbacks
 from ..errors import DimredError
+from ..geometry.mesh import to_probe_frame
 from ..io.exr import read_exr, write_exr
 from ..pipeline import relocate_object, remove_object
 from ..quality import DEFAULT_QUALITY
 from ..relocation.fixedview import Move
 from ..scene import SceneData
+from . import small_copy
+from .preview import Previews
+
+Layer = str | np.ndarray  # an EXR file's path (read in the worker) or (H, W, 3) float32 pixels
 
 
 @dataclass
@@ -35,11 +44,13 @@ class RemovalRequest:
     object_name: str
     planes: tuple[str, ...] = ()
     quality: str = DEFAULT_QUALITY
-    base: np.ndarray | None = None  # (H, W, 3) difference of the objects removed before
+    base: tuple[Layer, ...] = ()  # the own differences of the objects removed before
+    previous: Layer | None = None  # this object's own difference from a run before (the world shows it)
     own_path: str = ""  # where this removal's own difference goes
     layer_path: str = ""  # where base + own difference (what the world shows) goes
     overrides: dict = field(default_factory=dict)  # engine parameters that replace the preset's
     move: Move | None = None  # relocate the object by this move instead of removing it
+    cache_folder: str = ""  # where small copies of the files are kept between runs ("": nowhere)
 
 
 @dataclass
@@ -75,46 +86,141 @@ def loaded(scene: SceneData) -> SceneData:
     return replace(scene, hdri=read_exr(scene.hdri_path))
 
 
-def blender_pixels(image: np.ndarray) -> np.ndarray:
-    """(H, W, 3) top row first -> the flat RGBA float32 buffer `Image.pixels` takes (bottom row first)."""
-    h, w = image.shape[:2]
-    rgba = np.ones((h, w, 4), dtype=np.float32)
-    rgba[..., :3] = image[::-1]
-    return rgba.ravel()
-
-
 def run(request: RemovalRequest, callbacks: RunCallbacks = NO_CALLBACKS) -> RemovalOutcome:
-    """Remove (or relocate) the requested object; `callbacks.preview` gets the layer (base +
-    difference so far) as `blender_pixels` buffers, ready for the main thread to show."""
-    scene = loaded(request.scene)
-    base = request.base
-    if base is not None:
-        if base.shape != scene.hdri.shape:
-            raise DimredError(
-                f"the earlier removals' difference is {base.shape[1]}x{base.shape[0]} but the panorama is "
-                f"{scene.hdri.shape[1]}x{scene.hdri.shape[0]}: clear them and remove again"
-            )
-        scene = replace(scene, hdri=(scene.hdri + base).astype(np.float32))
-    engine_callbacks = callbacks.mapped_preview(
-        lambda difference: blender_pixels(difference if base is None else difference + base))
+    """Remove (or relocate) the requested object; `callbacks.preview` gets `preview.Preview`s:
+    a quick fill first, then the engine's."""
+    wanted = callbacks.preview is not None
+    _progress(callbacks, "preview")
+    panorama, base = _cached(request) if wanted else (None, [None] * len(request.base))
+    previews = None
+    if panorama is not None and None not in base:
+        previews = _quick(request, _small_input(panorama, base), callbacks)
+    callbacks.check()
+    _progress(callbacks, "reading")
+    scene, small = _engine_input(request, callbacks, panorama, base, small=wanted)
+    if previews is None and small is not None:
+        previews = _quick(request, small, callbacks)
+    engine_callbacks = callbacks
+    if previews is not None:
+        if request.previous is not None:
+            previous = (_copy(request.previous, request.cache_folder)
+                        or small_copy.of_image(_pixels(request.previous, scene.hdri.shape)))
+            previews = replace(previews, previous=small_copy.resample(previous.image, *previews.mask.shape))
+        engine_callbacks = callbacks.mapped_preview(previews.of_difference)
     engine = remove_object if request.move is None else functools.partial(relocate_object, move=request.move)
     result = engine(scene, request.object_name, planes=request.planes, quality=request.quality,
                     callbacks=engine_callbacks, **request.overrides)
-    layer = result.difference if base is None else (result.difference + base).astype(np.float32)
+    del scene  # the panorama: the layer needs only the difference and the base
+    difference, report = result.difference, result.report
+    del result
     callbacks.check()
+    return RemovalOutcome(report=report, staged=_write(request, difference))
+
+
+def _progress(callbacks: RunCallbacks, stage: str) -> None:
+    if callbacks.progress is not None:
+        callbacks.progress(stage, 0.0)
+
+
+def _quick(request: RemovalRequest, panorama: np.ndarray, callbacks: RunCallbacks) -> Previews:
+    """The run's previews on the small `panorama`, the quick fill shown."""
+    scene = request.scene
+    triangles = None
+    if request.object_name in scene.object_names:
+        mine = scene.tri_object == scene.object_index(request.object_name)
+        triangles = to_probe_frame(scene.triangles[mine], scene.center, scene.rotation)
+    previews, first = Previews.quick(panorama, triangles)
+    if first is not None:
+        callbacks.show(first)
+    return previews
+
+
+def _copy(layer: Layer, folder: str) -> small_copy.SmallCopy | None:
+    """The small copy of a file or pixels at hand without reading a file, if there is one."""
+    if isinstance(layer, np.ndarray):
+        return small_copy.of_image(layer)
+    return small_copy.cached(layer, folder) if folder else None
+
+
+def _cached(request: RemovalRequest) -> tuple[small_copy.SmallCopy | None, list[small_copy.SmallCopy | None]]:
+    """The small copies at hand, the panorama's and each earlier result's (None where missing)."""
+    scene, folder = request.scene, request.cache_folder
+    panorama = _copy(scene.hdri if scene.hdri is not None else scene.hdri_path, folder)
+    return panorama, [_copy(layer, folder) for layer in request.base]
+
+
+def _small_input(panorama: small_copy.SmallCopy, base: list[small_copy.SmallCopy]) -> np.ndarray:
+    """The small copy of HDRI + base."""
+    total = panorama.image
+    for copy in base:
+        # Copies of files of another size would be resampled: the full read refuses them later.
+        total = total + small_copy.resample(copy.image, *panorama.image.shape[:2])
+    return total
+
+
+def _engine_input(request: RemovalRequest, callbacks: RunCallbacks, panorama: small_copy.SmallCopy | None,
+                  base: list[small_copy.SmallCopy | None], *, small: bool) -> tuple[SceneData, np.ndarray | None]:
+    """The scene with its panorama read and the earlier results added to it, and, if `small`,
+    the small copy of that (from the small copies at hand where there are)."""
+    scene = loaded(request.scene)
+    hdri = scene.hdri
+    if small and panorama is None:
+        panorama = small_copy.of_image(hdri)
+        if request.cache_folder:
+            small_copy.store(scene.hdri_path, panorama, request.cache_folder)
+    callbacks.check()
+    copies = []
+    for layer, copy in zip(request.base, base, strict=True):
+        image = _pixels(layer, hdri.shape)
+        if hdri is request.scene.hdri:
+            hdri = hdri.astype(np.float32)  # a copy: the caller's array stays as it was
+        hdri += image
+        if small:
+            copies.append(copy or small_copy.of_image(image))
+        del image
+        callbacks.check()
+    return replace(scene, hdri=hdri), _small_input(panorama, copies) if small else None
+
+
+def _pixels(layer: Layer, shape: tuple[int, ...]) -> np.ndarray:
+    """The pixels of an earlier removal's difference, checked against the panorama's `shape`."""
+    image = read_exr(layer) if isinstance(layer, str) else layer
+    if image.shape != shape:
+        raise DimredError(
+            f"the earlier removals' difference is {image.shape[1]}x{image.shape[0]} but the panorama is "
+            f"{shape[1]}x{shape[0]}: clear them and remove again"
+        )
+    return image
+
+
+def _write(request: RemovalRequest, difference: np.ndarray) -> Staged:
+    """Stage this removal's own difference, then the layer (the base added to the same array),
+    and keep the own difference's small copy for the runs that will build on it."""
     staged = Staged()
     try:
-        for path, image in ((request.own_path, result.difference), (request.layer_path, layer)):
-            if path:
-                os.makedirs(os.path.dirname(path) or ".", exist_ok=True)
-                folder, name = os.path.split(path)
-                temporary = os.path.join(folder, f".{name}.{secrets.token_hex(4)}.staged.exr")
-                write_exr(temporary, image)
-                staged.moves.append((temporary, path))
+        if request.own_path:
+            temporary = _stage(staged, request.own_path, difference)
+            if request.cache_folder:
+                small_copy.store(request.own_path, small_copy.of_image(difference), request.cache_folder,
+                                 stat=os.stat(temporary))
+        if request.layer_path:
+            # In place: the engine's array is no one else's, and the own file is written.
+            for layer in request.base:
+                difference += _pixels(layer, difference.shape)
+            _stage(staged, request.layer_path, difference)
     except OSError as error:
         staged.discard()
         raise DimredError(f"cannot write the difference image: {error.strerror or error}") from None
     except BaseException:
         staged.discard()
         raise
-    return RemovalOutcome(report=result.report, staged=staged)
+    return staged
+
+
+def _stage(staged: Staged, path: str, image: np.ndarray) -> str:
+    os.makedirs(os.path.dirname(path) or ".", exist_ok=True)
+    folder, name = os.path.split(path)
+    temporary = os.path.join(folder, f".{name}.{secrets.token_hex(4)}.staged.exr")
+    staged.moves.append((temporary, path))
+    write_exr(temporary, image)
+    return temporary

@@ -24,20 +24,22 @@ _MIN_KNOWN = 64  # visible cells a surface needs to serve as its own exemplar
 
 @dataclass(frozen=True)
 class PanoramaMaps:
-    """(H, W) per pixel: the surface id and distance of the first hit with the object and
-    without it (-1 where nothing is hit), and whether the object is the first hit."""
+    """(h, w) per pixel of `frame` (default: the whole panorama): the surface id and distance
+    of the first hit with the object and without it (-1 where nothing is hit), and whether the
+    object is the first hit."""
 
     surface_with: np.ndarray
     distance_with: np.ndarray
     surface_without: np.ndarray
     distance_without: np.ndarray
     hidden: np.ndarray
+    frame: planeraster.Frame | None = None
 
 
 @dataclass(frozen=True)
 class PanoramaReflectance:
-    """What the panorama tells about reflectance: (H, W, 3) rho = pi L / E, (H, W) where it
-    was measured, and the surfaces each pixel sees."""
+    """What the panorama tells about reflectance: (h, w, 3) rho = pi L / E, (h, w) where it
+    was measured, and the surfaces each pixel sees, over the pixels of the maps' frame."""
 
     rho: np.ndarray
     valid: np.ndarray
@@ -93,9 +95,10 @@ def fill_surface(
                                       max_cells=_MAX_CELLS, along=plane.along)
     flags = planeraster.classify(raster, maps.surface_with, maps.distance_with, maps.surface_without,
                                  maps.distance_without, maps.hidden, surface=plane.surface,
-                                 tolerance=_DEPTH_TOLERANCE)
+                                 tolerance=_DEPTH_TOLERANCE, frame=maps.frame)
     values, weight = planeraster.sample_panorama(raster, panorama.rho,
-                                                 panorama.valid & (maps.surface_with == plane.surface))
+                                                 panorama.valid & (maps.surface_with == plane.surface),
+                                                 frame=maps.frame)
     known = (flags == planeraster.SEEN) & (weight > 0.5)
     # The hidden points are looked up bilinearly: fill the cells around each as well.
     r, c = (np.floor(x).astype(np.int64) for x in raster.coords(points))

@@ -30,16 +30,20 @@ from mathutils import Matrix
 
 from ...addon.errors import Cancelled, DimredError
 from ...addon.run.worker import Worker
-from . import world_layer
+from . import warmup, world_layer
 
 if TYPE_CHECKING:  # the engine is imported only when a run starts
+    from ...addon.callbacks import RunCallbacks
     from ...addon.relocation.fixedview import Move
-    from ...addon.run.job import RemovalOutcome, RemovalRequest
+    from ...addon.run.job import Layer, Preview, RemovalOutcome, RemovalRequest
     from ...addon.scene import SceneData
 
 PREVIEW_IMAGE = "DimRed Preview"
+PREVIEW_MASK_IMAGE = "DimRed Preview Mask"
 # Seconds a cancelled worker may take to notice; the engine checks far more often than this.
 STOP_TIMEOUT = 5.0
+# Seconds between a waiting run's checks for a cancel.
+WAIT_INTERVAL = 0.05
 
 _running: list[RemovalSession] = []
 
@@ -149,8 +153,7 @@ class RemovalSession:
     pack: bool
     relative: bool  # the output folder is given relative to the .blend
     photographed: Matrix  # the object's world matrix where the panorama shows it
-    temporary_folder: str = ""
-    previous_layer: str = ""  # the image the world showed before, restored on cancel
+    temporary_folder: str = ""  # files of this run only: packed results, earlier packed differences
     worker: Worker | None = None
     done: bool = False
     stage: str = "starting"
@@ -187,56 +190,75 @@ class RemovalSession:
         pack = settings.storage == 'PACK'
         folder = "" if pack else output_folder(settings)
         world_layer.world_nodes(world)  # refuses a world the layer cannot be added to, before the work
+        earlier = _earlier(settings, target)
+        # Packed results and the earlier packed differences go to files the worker can read.
+        own = _own(settings, target)
+        shown = [r.image for r in earlier] + [own]
+        packed = any(image is not None and image.packed_file is not None for image in shown)
+        scratch = tempfile.mkdtemp(prefix="dimred-") if pack or packed else ""
         if pack:
-            folder = tempfile.mkdtemp(prefix="dimred-")
+            folder = scratch
         try:
             reader.check_object(scene, target)
             names = settings.surface_names()
             for name in names:
                 reader.check_object(scene, name, purpose="used as a target surface")
-            earlier = _earlier(settings, target)
             if photographed is None:
                 photographed = photographed_matrix(settings, scene.objects[target])
             scene_data = engine_scene(scene, target, photographed)
-            # Its shape is checked against the panorama's in the worker, where the panorama is read.
-            base = _sum_images([r.image for r in earlier])
+            # Their shapes are checked against the panorama's in the worker, where it is read.
+            base = tuple(_layer_source(r.image, os.path.join(scratch, f"earlier_{i}.exr"))
+                         for i, r in enumerate(earlier))
+            previous = _layer_source(own, os.path.join(scratch, "previous.exr")) if own is not None else None
             request = RemovalRequest(
                 scene=scene_data, object_name=target, planes=names, quality=settings.quality, base=base,
                 own_path=os.path.join(folder, own_filename(world, target)),
                 layer_path=os.path.join(folder, layer_filename(world)), overrides=settings.overrides(), move=move,
+                previous=previous, cache_folder=warmup.folder(),
             )
         except BaseException:
-            if pack:
-                shutil.rmtree(folder, ignore_errors=True)
+            if scratch:
+                shutil.rmtree(scratch, ignore_errors=True)
             raise
-        previous = world_layer.layer_image(world) if world_layer.has_layer(world) else None
         index = _index(settings, target)
         later = [r.object_name for r in settings.removals[index + 1:]] if index >= 0 else []
         warnings = [(f"'{', '.join(later)}' were removed after '{target}' with it still in place: "
                      "remove them again for the most accurate result")] if later else []
         return cls(scene_name=scene.name, world_name=world.name, object_name=target, request=request, pack=pack,
                    relative=settings.output_dir.strip().startswith("//") and not pack, photographed=photographed,
-                   temporary_folder=folder if pack else "",
-                   previous_layer=previous.name if previous is not None else "", warnings=warnings)
+                   temporary_folder=scratch, warnings=warnings)
 
     # -- computing ------------------------------------------------------------------------
     def run_here(self, context: bpy.types.Context) -> bool:
         """Compute on this thread and apply; True on success (`message` says what happened)."""
-        from ...addon.run.job import run
+        from ...addon.callbacks import NO_CALLBACKS
 
         try:
-            outcome = run(self.request)
+            outcome = self._task()(NO_CALLBACKS)
         except DimredError as error:
             return self._fail(context, str(error))
         return self._apply(context, outcome)
 
     def start(self) -> None:
         """Compute in a worker thread; `tick` polls it."""
+        self.worker = Worker(self._task()).start()
+        _running.append(self)
+
+    def _task(self):
+        """The run as a function of its callbacks: first waiting for the small copy of the
+        panorama if a thread is making it (its first preview needs it, and reading the file
+        meanwhile would read it twice)."""
         from ...addon.run.job import run
 
         request = self.request
-        self.worker = Worker(lambda callbacks: run(request, callbacks)).start()
-        _running.append(self)
+        warming = warmup.running(request.scene.hdri_path) if request.scene.hdri is None else None
+
+        def task(callbacks: RunCallbacks) -> RemovalOutcome:
+            while warming is not None and not warming.join(WAIT_INTERVAL):
+                callbacks.check()
+            return run(request, callbacks)
+
+        return task
 
     def tick(self, context: bpy.types.Context) -> str:
         """Poll the worker: 'RUNNING', 'FINISHED' or 'CANCELLED' (failed or cancelled)."""
@@ -280,24 +302,13 @@ class RemovalSession:
     def _world(self) -> bpy.types.World | None:
         return bpy.data.worlds.get(self.world_name)
 
-    def _show_preview(self, context: bpy.types.Context, pixels: np.ndarray) -> None:
+    def _show_preview(self, context: bpy.types.Context, preview: Preview) -> None:
         world = self._world()
         if world is None:
             return
-        size = _image_size(world)
-        if len(pixels) != size[0] * size[1] * 4:
-            return  # the world's image was swapped for another size while the run went on
-        image = bpy.data.images.get(PREVIEW_IMAGE)
-        if image is not None and tuple(image.size) != size:
-            bpy.data.images.remove(image)
-            image = None
-        if image is None:
-            image = bpy.data.images.new(PREVIEW_IMAGE, size[0], size[1], alpha=True, float_buffer=True)
-            image.colorspace_settings.name = world_layer.DIFFERENCE_COLORSPACE
-        image.pixels.foreach_set(pixels)
-        image.update()
-        if world_layer.layer_image(world) is not image:
-            world_layer.add_layer(world, image)
+        color = _preview_image(PREVIEW_IMAGE, preview.width, preview.height, preview.color)
+        mask = _preview_image(PREVIEW_MASK_IMAGE, preview.width, preview.height, preview.mask)
+        world_layer.show_preview(world, color, mask)
         world.update_tag()
         _redraw(context)
 
@@ -315,10 +326,10 @@ class RemovalSession:
         request = self.request
         own = _load(request.own_path, os.path.basename(request.own_path)[:-4], self.relative, self.pack)
         layer = _load(request.layer_path, os.path.basename(request.layer_path)[:-4], self.relative, self.pack)
-        if self.pack:
+        if self.temporary_folder:
             shutil.rmtree(self.temporary_folder, ignore_errors=True)
+        world_layer.add_layer(world, layer)  # in place of the preview
         _drop_preview()
-        world_layer.add_layer(world, layer)
         settings = scene.dimred
         index = _index(settings, self.object_name)
         entry = settings.removals[index] if index >= 0 else settings.removals.add()
@@ -356,13 +367,8 @@ class RemovalSession:
     def _fail(self, context: bpy.types.Context | None, message: str) -> bool:
         """Put the world back as it was before this session and keep `message`."""
         world = self._world()
-        shown = world_layer.layer_image(world) if world is not None else None
-        if shown is not None and shown.name == PREVIEW_IMAGE:
-            previous = bpy.data.images.get(self.previous_layer) if self.previous_layer else None
-            if previous is not None:
-                world_layer.add_layer(world, previous)
-            else:
-                world_layer.remove_layer(world)
+        if world is not None:
+            world_layer.remove_preview(world)
         _drop_preview()
         if self.temporary_folder:
             shutil.rmtree(self.temporary_folder, ignore_errors=True)
@@ -408,15 +414,23 @@ def _index(settings: bpy.types.PropertyGroup, object_name: str) -> int:
     return next((i for i, r in enumerate(settings.removals) if r.object_name == object_name), -1)
 
 
-def _sum_images(images: list[bpy.types.Image]) -> np.ndarray | None:
-    if not images:
-        return None
-    return np.sum([world_layer.image_rgb(image) for image in images], axis=0, dtype=np.float32)
+def _own(settings: bpy.types.PropertyGroup, object_name: str) -> bpy.types.Image | None:
+    """The own difference of an earlier run on `object_name`, which the world shows now."""
+    index = _index(settings, object_name)
+    return settings.removals[index].image if index >= 0 else None
 
 
-def _image_size(world: bpy.types.World) -> tuple[int, int]:
-    original, _ = world_layer.world_nodes(world)
-    return tuple(original.image.size)
+def _layer_source(image: bpy.types.Image, unpacked: str) -> Layer:
+    """An earlier removal's difference as the worker reads it: its EXR file (a packed one
+    written to the path `unpacked` first), or, for an image that is not its file, its pixels."""
+    if image.packed_file is not None:
+        with open(unpacked, "wb") as file:
+            file.write(image.packed_file.data)
+        return unpacked
+    path = os.path.normpath(bpy.path.abspath(image.filepath, library=image.library))
+    if image.source == 'FILE' and not image.is_dirty and os.path.isfile(path):
+        return path
+    return world_layer.image_rgb(image)
 
 
 def _load(path: str, name: str, relative: bool, pack: bool) -> bpy.types.Image:
@@ -427,10 +441,25 @@ def _load(path: str, name: str, relative: bool, pack: bool) -> bpy.types.Image:
     return image
 
 
-def _drop_preview() -> None:
-    image = bpy.data.images.get(PREVIEW_IMAGE)
-    if image is not None:
+def _preview_image(name: str, width: int, height: int, pixels: np.ndarray) -> bpy.types.Image:
+    """The preview image `name` of that size (made anew for another size) holding `pixels`."""
+    image = bpy.data.images.get(name)
+    if image is not None and tuple(image.size) != (width, height):
         bpy.data.images.remove(image)
+        image = None
+    if image is None:
+        image = bpy.data.images.new(name, width, height, alpha=True, float_buffer=True)
+        image.colorspace_settings.name = world_layer.DIFFERENCE_COLORSPACE
+    image.pixels.foreach_set(pixels)
+    image.update()
+    return image
+
+
+def _drop_preview() -> None:
+    for name in (PREVIEW_IMAGE, PREVIEW_MASK_IMAGE):
+        image = bpy.data.images.get(name)
+        if image is not None:
+            bpy.data.images.remove(image)
 
 
 def _redraw(context: bpy.types.Context | None) -> None:

@@ -8,19 +8,19 @@ import os
 import subprocess
 import sys
 from pathlib import Path
-from types import SimpleNamespace
 
 import bpy
 import numpy as np
 import pytest
 
-from addon import pipeline
-from addon.blender import cli
+from addon import memory, pipeline
+from addon.blender import cli, reader
 from addon.callbacks import NO_CALLBACKS
 from addon.errors import DimredError
 from addon.io import exr
 from addon.io.exr import read_exr, write_exr
 from addon.relocation.fixedview import Move
+from addon.removal import RemovalResult
 from tests.blender.tiny_scene import environment_world
 
 pytestmark = pytest.mark.usefixtures("fresh_blender")
@@ -57,6 +57,15 @@ def _save_scene(folder: Path, image_path: Path | None = None) -> Path:
     return path
 
 
+class BandedResult(RemovalResult):
+    """A removal's result whose edited panorama can only be had by rows, as a writer that never
+    holds it whole takes it."""
+
+    @property
+    def edited(self):
+        raise AssertionError("the whole edited panorama was built")
+
+
 class FakeEngine:
     """Stands in for `pipeline.remove_object`; records its call, returns a fixed result."""
 
@@ -83,8 +92,7 @@ class FakeEngine:
             "guards": {"reflectance_clamped": 3},
             "hidden_region_filled": self.filled,
         }
-        return SimpleNamespace(difference=difference, edited=scene_data.hdri + difference, hidden_mask=mask,
-                               report=report)
+        return BandedResult(difference=difference, hidden_mask=mask, report=report, hdri=scene_data.hdri)
 
 
 @pytest.fixture
@@ -103,7 +111,8 @@ def _lines(text: str) -> list[str]:
     return [line for line in text.splitlines() if line.strip()]
 
 
-def test_success_writes_the_three_files(room, engine, tmp_path, capfd):
+def test_success_writes_the_three_files(room, engine, monkeypatch, tmp_path, capfd):
+    monkeypatch.setattr(exr, "BAND_ROWS", 3)  # the 8 rows in three bands
     out = tmp_path / "result"
     code = cli.main(["remove", str(room), "--object", "Box", "--plane", "Floor", "--out", str(out),
                      "--quality", "draft"])
@@ -236,17 +245,50 @@ def test_failed_write_leaves_earlier_results_intact(room, engine, monkeypatch, t
     assert cli.main(["remove", str(room), "--object", "Box", "--out", str(out)]) == 0
     before = {name: (out / name).read_bytes() for name in os.listdir(out)}
     capfd.readouterr()
-    real_write = exr.write_exr
+    real_write = exr.write_exr_rows
 
-    def disk_full_at_second_image(path, image):
+    def disk_full_at_second_image(path, height, width, rows):
         if os.path.basename(path) == "edited.exr":
             raise DimredError(f"cannot write {path}: No space left on device")
-        real_write(path, image)
+        real_write(path, height, width, rows)
 
-    monkeypatch.setattr(exr, "write_exr", disk_full_at_second_image)
+    monkeypatch.setattr(exr, "write_exr_rows", disk_full_at_second_image)
     monkeypatch.setattr(pipeline, "remove_object", FakeEngine(difference=1.0))
     code = cli.main(["remove", str(room), "--object", "Box", "--out", str(out)])
     _assert_failed_cleanly(code, capfd.readouterr().err, "No space left on device", out, before)
+
+
+def test_non_finite_values_in_a_later_band_write_nothing(room, monkeypatch, tmp_path, capfd):
+    class LastRowBroken(FakeEngine):
+        def __call__(self, scene_data, object_name, **options):
+            result = super().__call__(scene_data, object_name, **options)
+            result.difference[-1, -1, 2] = np.inf
+            return result
+
+    monkeypatch.setattr(exr, "BAND_ROWS", 3)
+    monkeypatch.setattr(pipeline, "remove_object", LastRowBroken())
+    out = tmp_path / "result"
+    code = cli.main(["remove", str(room), "--object", "Box", "--out", str(out)])
+    _assert_failed_cleanly(code, capfd.readouterr().err, "non-finite values in difference.exr", out, None)
+
+
+def test_a_panorama_too_big_for_the_free_memory_is_refused_before_it_is_read(room, engine, monkeypatch, tmp_path,
+                                                                           capfd):
+    monkeypatch.setattr(memory, "available_bytes", lambda: 100_000_000)
+
+    def pixels_read(path):
+        raise AssertionError(f"the pixels of {path} were read")
+
+    monkeypatch.setattr(reader, "read_exr", pixels_read)
+    blend = room.read_bytes()
+    out = tmp_path / "result"
+    code = cli.main(["remove", str(room), "--object", "Box", "--out", str(out), "--quality", "final"])
+    needed = memory.required_bytes(16, 8, quality="final") / 1e9
+    _assert_failed_cleanly(code, capfd.readouterr().err,
+                           f"a 16x8 panorama needs about {needed:.1f} GB of memory at quality 'final' but only 0.1 GB "
+                           "is available: close other programs or use a smaller copy of the panorama", out, None)
+    assert not engine.calls
+    assert room.read_bytes() == blend
 
 
 def test_out_is_a_file(room, engine, tmp_path, capfd):

@@ -77,16 +77,50 @@ def test_threaded_removal_previews_then_applies(room, tmp_path, extension, drive
     session.start()
     assert S.active() is session
     shown = []
-    state = drive(session, on_tick=lambda s: shown.append(
-        world_layer.layer_image(world).name if world_layer.has_layer(world) else None))
+    state = drive(session, on_tick=lambda s: shown.append(getattr(world_layer.preview_image(world), "name", None)))
     assert state == 'FINISHED', session.message
     # The coarse fill showed in the world before the result replaced it.
     assert S.PREVIEW_IMAGE in shown
-    assert S.PREVIEW_IMAGE not in bpy.data.images and S.active() is None
+    assert world_layer.preview_image(world) is None
+    assert S.PREVIEW_IMAGE not in bpy.data.images and S.PREVIEW_MASK_IMAGE not in bpy.data.images
+    assert S.active() is None
     difference = tiny_scene.read_exr(tmp_path / "dimred" / "Room_Probe_difference.exr")
     np.testing.assert_array_equal(world_layer.image_rgb(world_layer.layer_image(world)), difference)
     assert max(session.tick_seconds) < 0.1
     assert not [t for t in threading.enumerate() if t.name == "dimred-worker"]
+
+
+def test_the_first_preview_shows_before_the_panorama_is_read(room, tmp_path, extension, monkeypatch):
+    from addon.run import job, small_copy
+    from diminished_reality.operators.support import warmup, world_layer
+
+    S = _session(extension)
+    cache = str(tmp_path / "cache")
+    marked = warmup.running(str(room))  # marked by the fixture, making its copy elsewhere
+    assert marked is None or marked.join(10.0)
+    monkeypatch.setattr(warmup, "folder", lambda: cache)
+    settings = bpy.context.scene.dimred
+    settings.target = None
+    settings.target = bpy.data.objects["Box"]  # marking makes the panorama's small copy
+    making = warmup.running(str(room))
+    assert making is not None and making.join(10.0)
+    assert small_copy.cached(str(room), cache) is not None
+    reading, real = threading.Event(), job.read_exr
+    monkeypatch.setattr(job, "read_exr", lambda path: (reading.wait(10.0), real(path))[1])
+
+    session = S.RemovalSession.begin(bpy.context)
+    session.start()
+    world = bpy.context.scene.world
+    deadline = time.perf_counter() + 10.0
+    while world_layer.preview_image(world) is None and time.perf_counter() < deadline:
+        session.tick(bpy.context)
+        time.sleep(0.005)
+    # Shown while the panorama's read is held up.
+    assert world_layer.preview_image(world) is not None and not reading.is_set()
+    reading.set()
+    while session.tick(bpy.context) == 'RUNNING':
+        time.sleep(0.01)
+    assert session.ok, session.message
 
 
 def test_cancel_midway_changes_nothing(room, tmp_path, extension):
@@ -171,10 +205,12 @@ def test_undo_after_remove_restores_the_original_world(room, extension):
     assert world_layer.has_layer(bpy.context.scene.world)
 
 
-def test_a_second_object_composes_with_the_first(room, tmp_path, extension):
+@pytest.mark.parametrize("storage", ["FILE", "PACK"])
+def test_a_second_object_composes_with_the_first(room, tmp_path, extension, storage):
     from diminished_reality.operators.support import world_layer
 
     settings = bpy.context.scene.dimred
+    settings.storage = storage
     tiny_scene.mesh_object(bpy, "Crate", *tiny_scene.box_faces((-0.9, -0.8, 0.0), (-0.6, -0.5, 0.3)))
     assert bpy.ops.dimred.remove() == {'FINISHED'}
     settings.target = bpy.data.objects["Crate"]

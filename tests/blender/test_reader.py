@@ -4,11 +4,13 @@ per kind of bad scene."""
 from __future__ import annotations
 
 import math
+from types import SimpleNamespace
 
 import bpy
 import numpy as np
 import pytest
 
+from addon import radiance
 from addon.blender import reader
 from addon.errors import DimredError
 from addon.geometry import latlong
@@ -174,6 +176,61 @@ def test_generated_image_pixels(panorama_world):
     assert hdri.shape == (2, 4, 3)
     np.testing.assert_array_equal(hdri[0], np.broadcast_to(TOP, (4, 3)))
     np.testing.assert_array_equal(hdri[1], 0.0)
+
+
+class _Pixels:
+    """Image.pixels as a buffer of `values`, bottom row first."""
+
+    def __init__(self, values: np.ndarray):
+        self.values = values
+
+    def __len__(self) -> int:
+        return self.values.size
+
+    def foreach_get(self, out: np.ndarray) -> None:
+        out[...] = self.values
+
+
+@pytest.mark.parametrize("channels", [4, 3, 1])
+def test_blender_pixels_over_several_bands(monkeypatch, channels):
+    """Colour packed to the front and rows swapped in place, band by band: odd sizes, and each
+    buffer layout an image may have."""
+    monkeypatch.setattr(radiance, "_BAND_PIXELS", 10)  # one or two rows a band
+    width, height = 7, 5
+    texels = np.random.default_rng(2).random((height, width, channels)).astype(np.float32)
+    image = SimpleNamespace(pixels=_Pixels(texels[::-1].ravel()))
+    expected = texels[..., :3] if channels >= 3 else np.repeat(texels, 3, axis=2)
+    np.testing.assert_array_equal(reader._blender_rgb(image, width, height), expected)
+
+
+def test_blender_pixels_are_copied_once(monkeypatch):
+    """The RGB image is the very buffer Blender's RGBA pixels were copied into, shrunk."""
+    monkeypatch.setattr(radiance, "_BAND_PIXELS", 256)
+    pixels = _Pixels(np.random.default_rng(3).random(128 * 256 * 4).astype(np.float32))
+    buffers = []
+    copy_into = pixels.foreach_get
+
+    def foreach_get(out):
+        buffers.append(out.ctypes.data)
+        copy_into(out)
+
+    pixels.foreach_get = foreach_get
+    rgb = reader._blender_rgb(SimpleNamespace(pixels=pixels), 256, 128)
+    assert rgb.ctypes.data == buffers[0] and rgb.base.nbytes == rgb.nbytes
+
+
+def test_panorama_size_of_an_exr_file_comes_from_its_header(world, monkeypatch):
+    def pixels_read(path):
+        raise AssertionError(f"the pixels of {path} were read")
+
+    monkeypatch.setattr(reader, "read_exr", pixels_read)
+    assert reader.panorama_size(bpy.context.scene) == (8, 4)
+    assert not world.nodes["Environment Texture"].image.has_data
+
+
+def test_panorama_size_of_a_blender_image(panorama_world):
+    panorama_world(bpy.data.images.new("painted", 32, 16, float_buffer=True))
+    assert reader.panorama_size(bpy.context.scene) == (32, 16)
 
 
 def test_non_linear_colour_space_is_converted_as_blender_does_and_noted(world, panorama_file):

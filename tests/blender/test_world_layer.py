@@ -125,3 +125,70 @@ def test_difference_image_loads_raw_and_top_row_first(world_layer, tmp_path):
     reloaded = world_layer.load_difference_image(str(path), "test difference")
     assert reloaded == image
     np.testing.assert_allclose(world_layer.image_rgb(reloaded), pixels * 2.0, rtol=1e-6)
+
+
+def _flat(pixels: np.ndarray) -> np.ndarray:
+    """(H, W, 3) top row first -> an Image.pixels buffer."""
+    rgba = np.ones((*pixels.shape[:2], 4), np.float32)
+    rgba[..., :3] = pixels[::-1]
+    return rgba.ravel()
+
+
+def _image(name: str, pixels: np.ndarray) -> bpy.types.Image:
+    image = bpy.data.images.new(name, pixels.shape[1], pixels.shape[0], alpha=True, float_buffer=True)
+    image.colorspace_settings.name = 'Non-Color'
+    image.pixels.foreach_set(_flat(pixels))
+    return image
+
+
+@pytest.mark.parametrize("layered", [False, True], ids=["original", "over a layer"])
+@pytest.mark.parametrize("with_mapping", [False, True], ids=["plain", "mapping"])
+def test_a_preview_sits_over_what_the_world_shows_and_leaves_no_trace(world_layer, extension, layered, with_mapping):
+    from addon.blender import reader
+
+    world = _world(with_mapping)
+    if layered:
+        world_layer.add_layer(world, _difference_image())
+    nodes_before, links_before = sorted(n.name for n in world.node_tree.nodes), _links(world)
+    environment, background = world_layer.world_nodes(world)
+    color, mask = _difference_image(), _difference_image()
+
+    world_layer.show_preview(world, color, mask)
+    world_layer.show_preview(world, color, mask)
+
+    nodes = world.node_tree.nodes
+    keep, add = nodes[world_layer.PREVIEW_KEEP_NAME], nodes[world_layer.PREVIEW_ADD_NAME]
+    assert world_layer.preview_image(world) == color and nodes[world_layer.PREVIEW_MASK_NAME].image == mask
+    assert (keep.blend_type, add.blend_type, keep.clamp_result, add.clamp_result) == ('MIX', 'ADD', False, False)
+    assert (add.name, "Result_Color", background.name, "Color") in _links(world)
+    assert len(nodes) == len(nodes_before) + len(world_layer.PREVIEW_NODE_NAMES)
+    assert world_layer.world_nodes(world) == (environment, background)
+    assert world_layer.has_layer(world) == layered
+    # The reader sees through it: a file saved during a run still reads as the panorama.
+    bpy.context.scene.world = world
+    assert reader.read_scene(bpy.context.scene).hdri.shape == (4, 8, 3)
+
+    world_layer.remove_preview(world)
+    assert sorted(n.name for n in world.node_tree.nodes) == nodes_before and _links(world) == links_before
+    world_layer.show_preview(world, color, mask)
+    world_layer.add_layer(world, _difference_image())
+    assert world_layer.preview_image(world) is None and world_layer.has_layer(world)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("layered", [False, True], ids=["original", "over a layer"])
+def test_cycles_renders_the_preview_over_the_world(world_layer, panorama_world, render_world, layered):
+    rng = np.random.default_rng(3)
+    hdri = rng.random((32, 64, 3)).astype(np.float32)
+    difference = rng.normal(0.0, 0.2, (32, 64, 3)).astype(np.float32)
+    color = rng.normal(0.0, 1.0, (32, 64, 3)).astype(np.float32)
+    mask = rng.choice(np.array([0.0, 0.25, 1.0], np.float32), (32, 64))
+    panorama_world(_image("hdri", hdri))
+    world = bpy.context.scene.world
+    shown = hdri
+    if layered:
+        world_layer.add_layer(world, _image("difference", difference))
+        shown = hdri + difference
+    world_layer.show_preview(world, _image("preview", color), _image("mask", np.repeat(mask[..., None], 3, 2)))
+    render = render_world(64, 32)
+    np.testing.assert_allclose(render, shown * (1.0 - mask[..., None]) + color, atol=1e-5)

@@ -1,8 +1,8 @@
-"""Panorama ray casting and segment occlusion against analytic geometry."""
+"""Panorama ray casting and ray hits against analytic geometry."""
 import numpy as np
 import pytest
 
-from addon.geometry.raycast import Occluders, trace_panorama
+from addon.geometry.raycast import trace_panorama
 from tests.engine.tiny_room import box_triangles as box
 
 ROOM = box([-2.0, -2.5, -1.5], [3.0, 1.5, 1.2])
@@ -26,27 +26,6 @@ def test_object_across_the_seam_and_below_the_probe_is_seen_whole():
     assert hits.tri[:, 0].max() >= 12 and hits.tri[:, -1].max() >= 12  # both sides of the seam
     assert (hits.tri[-1] >= 24).all()  # the bottom row sees the nadir box all around
     assert (hits.tri >= 0).all()
-
-
-def test_segments_blocked_by_a_box_match_a_dense_check():
-    rng = np.random.default_rng(0)
-    obstacle = box([0.0, 0.0, 0.0], [1.0, 1.0, 1.0])
-    occ = Occluders(obstacle, np.zeros(12, int), 1e-9)
-    p0 = rng.uniform(-1, 2, (30000, 3))
-    p1 = rng.uniform(-1, 2, (30000, 3))
-    outside = ~((p0 > 0) & (p0 < 1)).all(axis=1) & ~((p1 > 0) & (p1 < 1)).all(axis=1)
-    p0, p1 = p0[outside], p1[outside]  # light never starts inside a solid
-    # An axis-aligned box is its own bounding box: the slab test is the exact answer.
-    d = p1 - p0
-    with np.errstate(divide="ignore", invalid="ignore"):
-        t0, t1 = (0.0 - p0) / d, (1.0 - p0) / d
-    near = np.minimum(t0, t1).max(axis=1)
-    far = np.maximum(t0, t1).min(axis=1)
-    exact = (near < far) & (far > 0) & (near < 1)
-    got = occ.blocked(p0, p1)
-    assert exact.sum() > 1000 and (got == exact).all()
-    # endpoints on the surface do not block themselves
-    assert not occ.blocked(np.array([[0.5, 0.5, 1.0]]), np.array([[0.5, 0.5, 3.0]]))[0]
 
 
 @pytest.mark.parametrize("offset", [0.02, 0.05, 0.11])

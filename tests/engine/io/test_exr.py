@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 import struct
+import tracemalloc
 import zlib
 
 import numpy as np
@@ -80,6 +81,104 @@ def test_reads_the_part_with_colour_channels(tmp_path):
     np.testing.assert_array_equal(exr.read_exr(tmp_path / "parts.exr"), image)
 
 
+@pytest.fixture
+def small_bands(monkeypatch):
+    """Bands of 4 rows, so that images of a few rows take several."""
+    monkeypatch.setattr(exr, "BAND_ROWS", 4)
+
+
+@pytest.mark.usefixtures("small_bands")
+def test_reads_band_by_band_from_a_data_window_off_the_origin(tmp_path):
+    image = _hdr_image(height=11)
+    window = (np.array([2, 3], np.int32), np.array([11, 13], np.int32))
+    _write_raw(tmp_path / "w.exr", {c: np.ascontiguousarray(image[..., i]) for i, c in enumerate("RGB")},
+               dataWindow=window, displayWindow=window)
+    np.testing.assert_array_equal(exr.read_exr(tmp_path / "w.exr"), image)
+    assert exr.exr_size(tmp_path / "w.exr") == (10, 11)
+
+
+@pytest.mark.usefixtures("small_bands")
+def test_half_float_is_read_band_by_band(tmp_path):
+    image = _hdr_image(height=9).astype(np.float16)
+    _write_raw(tmp_path / "h.exr", {c: np.ascontiguousarray(image[..., i]) for i, c in enumerate("RGB")},
+               lineOrder=OpenEXR.DECREASING_Y)
+    np.testing.assert_array_equal(exr.read_exr(tmp_path / "h.exr"), image.astype(np.float32))
+
+
+def test_size_comes_from_the_header_alone(tmp_path):
+    exr.write_exr(tmp_path / "full.exr", _hdr_image(height=40, width=80))
+    data = (tmp_path / "full.exr").read_bytes()
+    # With its pixel data cut short the file cannot be read, but its header still gives the size.
+    (tmp_path / "cut.exr").write_bytes(data[: len(data) // 2])
+    assert exr.exr_size(tmp_path / "cut.exr") == (80, 40)
+    with pytest.raises(DimredError, match="cannot read EXR file"):
+        exr.read_exr(tmp_path / "cut.exr")
+
+
+def test_size_of_the_part_with_colour_channels(tmp_path):
+    # Parts share the display window; the depth part's data covers a corner of it.
+    display = (np.array([0, 0], np.int32), np.array([9, 5], np.int32))
+    corner = (np.array([0, 0], np.int32), np.array([4, 2], np.int32))
+    depth = OpenEXR.Part({"type": OpenEXR.scanlineimage, "displayWindow": display, "dataWindow": corner},
+                         {"Z": np.ones((3, 5), np.float32)})
+    colour = OpenEXR.Part({"type": OpenEXR.scanlineimage, "displayWindow": display},
+                          {c: np.ascontiguousarray(_hdr_image()[..., i]) for i, c in enumerate("RGB")})
+    OpenEXR.File([depth, colour]).write(str(tmp_path / "parts.exr"))
+    assert exr.exr_size(tmp_path / "parts.exr") == (10, 6)
+    with pytest.raises(DimredError, match="not found"):
+        exr.exr_size(tmp_path / "nope.exr")
+
+
+def _peak_bytes(call) -> int:
+    """The most memory Python and numpy held at once during call(), above what they held before."""
+    tracemalloc.start()
+    try:
+        call()
+        return tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+
+
+@pytest.mark.usefixtures("small_bands")
+def test_read_and_write_hold_one_band_besides_the_image(tmp_path):
+    image = _hdr_image(height=128, width=256)
+    band = image[: exr.BAND_ROWS].nbytes
+    assert _peak_bytes(lambda: exr.write_exr(tmp_path / "a.exr", image)) <= 2 * band + 64_000
+    assert _peak_bytes(lambda: exr.read_exr(tmp_path / "a.exr")) <= image.nbytes + 2 * band + 64_000
+    # A half-float file too: the library converts it to float32 band by band.
+    half = {c: np.ascontiguousarray(image[..., i], dtype=np.float16) for i, c in enumerate("RGB")}
+    _write_raw(tmp_path / "h.exr", half)
+    assert _peak_bytes(lambda: exr.read_exr(tmp_path / "h.exr")) <= image.nbytes + 2 * band + 64_000
+
+
+@pytest.mark.usefixtures("small_bands")
+def test_rows_are_asked_for_once_each_top_first(tmp_path):
+    image = _hdr_image(height=10).astype(np.float64)
+    asked = []
+
+    def rows(start, stop):
+        asked.append((start, stop))
+        return image[start:stop]
+
+    exr.write_exr_rows(tmp_path / "r.exr", 10, 10, rows)
+    assert asked == [(0, 4), (4, 8), (8, 10)]
+    np.testing.assert_array_equal(exr.read_exr(tmp_path / "r.exr"), image.astype(np.float32))
+
+
+@pytest.mark.usefixtures("small_bands")
+def test_a_failing_row_source_leaves_no_file(tmp_path):
+    def rows(start, stop):
+        if start >= 4:
+            raise DimredError("non-finite values")
+        return np.zeros((stop - start, 3, 3), np.float32)
+
+    with pytest.raises(DimredError, match="non-finite values"):
+        exr.write_exr_rows(tmp_path / "r.exr", 10, 3, rows)
+    with pytest.raises(ValueError, match="shape"):
+        exr.write_exr_rows(tmp_path / "r.exr", 10, 3, lambda start, stop: np.zeros((stop - start, 4, 3)))
+    assert os.listdir(tmp_path) == []
+
+
 def _single_line_error(path) -> str:
     with pytest.raises(DimredError) as caught:
         exr.read_exr(path)
@@ -112,28 +211,56 @@ def test_file_without_colour_channels(tmp_path):
     assert "no R, G, B channels (channels: Y)" in _single_line_error(tmp_path / "y.exr")
 
 
-def test_failed_write_keeps_the_old_file_and_leaves_no_temporary(tmp_path, monkeypatch):
+def _failing_write_keeps(tmp_path, monkeypatch, output_file, expected: str) -> None:
+    """With `output_file` standing in for OpenEXR.OutputFile, a write fails with `expected` in
+    its message, and the file written before is left as it was, with no temporary beside it."""
     path = tmp_path / "keep.exr"
     old = _hdr_image()
     exr.write_exr(path, old)
-
-    class HalfWritingFile:
-        """Stands in for OpenEXR.File: writes part of a file, then fails like a full disk."""
-
-        def __init__(self, header, channels):
-            pass
-
-        def write(self, target):
-            with open(target, "wb") as handle:
-                handle.write(b"v/1\x01partial")
-            raise RuntimeError("No space left on device")
-
-    monkeypatch.setattr(exr.OpenEXR, "File", HalfWritingFile)
-    with pytest.raises(DimredError, match="No space left on device"):
+    monkeypatch.setattr(exr.OpenEXR, "OutputFile", output_file)
+    with pytest.raises(DimredError, match=expected):
         exr.write_exr(path, np.zeros((2, 2, 3), np.float32))
     monkeypatch.undo()
     np.testing.assert_array_equal(exr.read_exr(path), old)
     assert os.listdir(tmp_path) == ["keep.exr"]
+
+
+def test_failed_write_keeps_the_old_file_and_leaves_no_temporary(tmp_path, monkeypatch):
+    class HalfWritingFile:
+        """Writes part of a file, then fails like a full disk."""
+
+        def __init__(self, target, header):
+            self.target = target
+
+        def writePixels(self, planes, rows):
+            with open(self.target, "wb") as handle:
+                handle.write(b"v/1\x01partial")
+            raise OSError("No space left on device")
+
+        def close(self):
+            pass
+
+    _failing_write_keeps(tmp_path, monkeypatch, HalfWritingFile, "No space left on device")
+
+
+def test_a_file_cut_short_as_it_is_closed_is_not_kept(tmp_path, monkeypatch):
+    real = exr.OpenEXR.OutputFile
+
+    class LosingTheLastBytes:
+        """The library's own writer, but the last bytes never reach the disk, as when the disk
+        fills up while the file is closed (the library drops that failure)."""
+
+        def __init__(self, target, header):
+            self.target, self.file = target, real(target, header)
+
+        def writePixels(self, planes, rows):
+            self.file.writePixels(planes, rows)
+
+        def close(self):
+            self.file.close()
+            os.truncate(self.target, os.path.getsize(self.target) - 1)
+
+    _failing_write_keeps(tmp_path, monkeypatch, LosingTheLastBytes, "incomplete")
 
 
 def test_write_into_missing_folder_is_an_error(tmp_path):

@@ -1,0 +1,42 @@
+"""The panorama's radiance as the engine reads it, a band of rows at a time.
+
+Negative radiance is not light (a bad merge or a denoiser's ringing): the engine reads it as
+black, through `clamped_rows`. Checks over the whole panorama scan it band by band, so that
+none builds a full-size temporary beside a 16384 x 8192 image.
+"""
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator
+
+import numpy as np
+
+_BAND_PIXELS = 1 << 21  # pixels per band: a float32 RGB band is 24 MB
+
+
+def row_bands(height: int, width: int) -> Iterator[tuple[int, int]]:
+    """(start, stop) of consecutive bands of rows covering `height` rows `width` pixels wide."""
+    rows = max(1, _BAND_PIXELS // max(1, width))
+    for start in range(0, height, rows):
+        yield start, min(start + rows, height)
+
+
+def clamped_rows(hdri: np.ndarray, start: int, stop: int) -> np.ndarray:
+    """Rows start:stop of the (H, W, 3) panorama with negative radiance read as black, in the
+    panorama's dtype (a new array)."""
+    return np.maximum(hdri[start:stop], 0)
+
+
+def negative_pixels(hdri: np.ndarray) -> int:
+    """How many pixels of the (H, W, 3) panorama have a negative channel."""
+    return _pixels_where(hdri, lambda band: (band < 0).any(axis=2))
+
+
+def non_finite_pixels(hdri: np.ndarray) -> int:
+    """How many pixels of the (H, W, 3) panorama have a NaN or infinite channel."""
+    return _pixels_where(hdri, lambda band: ~np.isfinite(band).all(axis=2))
+
+
+def _pixels_where(hdri: np.ndarray, test: Callable[[np.ndarray], np.ndarray]) -> int:
+    """How many pixels `test` (a band -> a bool per pixel) finds, over all bands."""
+    height, width = hdri.shape[:2]
+    return sum(int(np.count_nonzero(test(hdri[start:stop]))) for start, stop in row_bands(height, width))

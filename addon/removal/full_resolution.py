@@ -1,0 +1,349 @@
+"""The working-resolution solution applied to the full-resolution panorama.
+
+The change of light is smooth on a surface, so most full-resolution pixels take E and dE
+bilinearly from their four working neighbours; a pixel whose neighbours see another surface
+takes them from the neighbours on its own (found by testing the few triangles they see). A
+pixel no neighbour can serve, one beside the object, and one on a sharp shadow edge (its
+neighbours' relative change differs widely) gets its own light, computed like a working
+pixel's. The hidden region is filled at the panorama's own resolution. The panorama is read
+and the difference written in bands of rows, into one float32 image.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..callbacks import RunCallbacks
+from ..geometry import latlong
+from ..geometry.planeraster import PlaneRaster, build_raster
+from ..light.radiosity import LUMA
+from ..report import Report
+from ..synthesis.plane_fill import PanoramaMaps, PanoramaReflectance
+from .compose import ratio_change, reference_irradiance
+from .fill import Revealed, fill_hidden, hidden_planes, measured_reflectance, surface_footprint
+from .local import Receiving, light_at
+from .object_window import ObjectWindow, object_window
+from .solution import Solution
+from .working_maps import Cells, WorkingMaps, cells, neighbours, pixel_directions_at, surfaces_seen, working_maps
+
+_BAND_PIXELS = 1 << 21  # full-resolution pixels per band
+_SHARP = 0.1  # neighbours whose dE / E differ by more than this leave the pixel to be refined
+
+
+@dataclass(frozen=True)
+class FullResolution:
+    """The full-resolution difference (H, W, 3) float32, the hidden mask (H, W) and whether
+    every hidden pixel was filled."""
+
+    difference: np.ndarray
+    hidden_mask: np.ndarray
+    filled: bool
+
+
+@dataclass(frozen=True)
+class _Refine:
+    """Full-resolution pixels that get their own light: flat index, what they see."""
+
+    pixel: np.ndarray
+    tri: np.ndarray
+    bary: np.ndarray
+    distance: np.ndarray
+    spread: np.ndarray  # how much its neighbours' dE / E differ; inf where the pixel must be refined
+    beside: np.ndarray  # bool: beside the object's silhouette (its light is computed at the pixel itself)
+
+
+def full_resolution(solution: Solution, hdri: np.ndarray, rep: Report, callbacks: RunCallbacks) -> FullResolution:
+    """Apply the working `solution` to the full-resolution panorama `hdri` (H, W, 3)."""
+    height, width = hdri.shape[:2]
+    full = (height, width)
+    maps = working_maps(solution)
+    window = object_window(solution.geo, solution.target, solution.traced.hidden_map, _exemplar_extent(solution),
+                           full, maps)
+    apply = ~solution.traced.hidden_h & ~solution.room.pixels.emitter_h
+    e_ref = reference_irradiance(solution.e_h, apply)
+    difference = np.zeros((height, width, 3), dtype=np.float32)
+    window_e = None if window is None else np.zeros((*window.hidden.shape, 3), dtype=np.float32)
+    with rep.stage("upsample"):
+        refine = _upsample(solution, maps, window, hdri, difference, window_e, e_ref, rep, callbacks)
+    callbacks.check()
+    with rep.stage("refine"):
+        _refine(solution, refine, hdri, difference, window, window_e, e_ref, rep, callbacks)
+    hidden_mask = np.zeros(full, dtype=bool)
+    if window is None:
+        rep.skip("synthesis", "the object is not visible from the probe centre: no hidden region to fill")
+        return FullResolution(difference, hidden_mask, True)
+    rows, cols = _window_pixels(window)
+    hidden_mask[rows, cols] = window.hidden
+    revealed = window.hidden & (window.tri >= 0)
+    if revealed.any():
+        with rep.stage("synthesis"):
+            found = _revealed(solution, window, window_e, hdri, revealed, e_ref)
+            change = fill_hidden(solution, found, rep, callbacks)
+            difference[rows[revealed], cols[revealed]] = change
+    else:
+        rep.skip("synthesis", "nothing is behind the object to fill")
+    unseen = int(window.hidden.sum() - revealed.sum())
+    if unseen:
+        rep.warn(f"{unseen} pixels of the object see no proxy geometry behind it; they are left unchanged")
+    return FullResolution(difference, hidden_mask, unseen == 0)
+
+
+def _exemplar_extent(solution: Solution) -> np.ndarray:
+    """(N, 3) points spanning the rasters the fill will read its exemplars from (the working
+    solution's revealed points stand for the full-resolution ones)."""
+    behind = solution.traced.behind
+    if not len(behind.revealed):
+        return np.zeros((0, 3))
+    spans = []
+    for _, plane in hidden_planes(solution.geo, solution.target.surface_key, behind.tri, behind.points):
+        raster = build_raster(plane.normal, plane.points, cell=1e-9, margin=solution.params.exemplar_margin,
+                              max_cells=1, along=plane.along)
+        spans.append(_raster_outline(raster))
+    return np.concatenate(spans)
+
+
+def _raster_outline(raster: PlaneRaster, *, steps: int = 64) -> np.ndarray:
+    """(N, 3) points on a raster's plane filling its rectangle (a grid, so the rectangle's
+    image in the panorama is covered wherever it bends)."""
+    h, w = raster.shape
+    t = np.linspace(0.0, 1.0, steps)
+    i, j = np.meshgrid(t * h * raster.cell, t * w * raster.cell, indexing="ij")
+    return (raster.origin + i[..., None] * raster.v + j[..., None] * raster.u).reshape(-1, 3)
+
+
+def _window_pixels(window: ObjectWindow) -> tuple[np.ndarray, np.ndarray]:
+    """(h, w) panorama rows and columns of the window's pixels."""
+    f = window.frame
+    h, w = window.hidden.shape
+    rows = np.broadcast_to((f.row0 + np.arange(h))[:, None], (h, w))
+    cols = np.broadcast_to(np.mod(f.col0 + np.arange(w), f.width)[None, :], (h, w))
+    return rows, cols
+
+
+def _upsample(solution: Solution, maps: WorkingMaps, window: ObjectWindow | None, hdri: np.ndarray,
+              difference: np.ndarray, window_e: np.ndarray | None, e_ref: float, rep: Report,
+              callbacks: RunCallbacks) -> _Refine:
+    """Write the upsampled change band by band; the pixels left to refine."""
+    height, width = hdri.shape[:2]
+    grid = cells(maps)
+    top, bottom = Cells.rows(maps)
+    x = (np.arange(width) + 0.5) * (maps.width / width) - 0.5
+    col = np.mod(np.floor(x).astype(np.int64), maps.width)
+    col_next = np.mod(col + 1, maps.width)
+    fx = (x - np.floor(x)).astype(np.float32)[None, :, None]
+    e_map = maps.e.reshape(maps.height, maps.width, 3)
+    de_map = maps.de.reshape(maps.height, maps.width, 3)
+    band = max(1, _BAND_PIXELS // width)
+    parts: list[_Refine] = []
+    for start in range(0, height, band):
+        callbacks.check()
+        rows = np.arange(start, min(start + band, height))
+        y = (rows + 0.5) * (maps.height / height) - 0.5
+        pair = np.clip(np.floor(y).astype(np.int64) + 1, 0, maps.height)
+        fy = (y - np.floor(y)).astype(np.float32)[:, None, None]
+
+        def bilinear(image: np.ndarray, pair: np.ndarray = pair, fy: np.ndarray = fy) -> np.ndarray:
+            across = image[top[pair]] * (1 - fy) + image[bottom[pair]] * fy
+            return across[:, col] * (1 - fx) + across[:, col_next] * fx
+
+        e, de = bilinear(e_map).reshape(-1, 3), bilinear(de_map).reshape(-1, 3)
+        plain = grid.plain[pair][:, col].ravel()
+        sharp = plain & (grid.spread[pair][:, col].ravel() > _SHARP)
+        cell_key = maps.key[(top[pair] * maps.width)[:, None] + col[None, :]].ravel()
+        pixels = _BandPixels.of(rows, width, window, solution.target.surface_key)
+        # The pixels the cells cannot serve as they are: those of a mixed cell, and in the
+        # window those hidden, beside the object or on another surface than their cell's.
+        fast = plain & ~pixels.hidden & ~pixels.ring & ((pixels.own == cell_key) | ~pixels.known)
+        slow = np.flatnonzero(~fast & ~pixels.hidden)
+        served = fast.copy()
+        refine = np.zeros(len(plain), dtype=bool)
+        spread = np.where(sharp, grid.spread[pair][:, col].ravel(), 0.0)
+        if len(slow):
+            got = _mixed(solution, maps, pixels, rows, width, slow, height)
+            e[slow], de[slow] = got.e, got.de
+            served[slow] = got.served
+            refine[slow] = got.needed
+            spread[slow[got.needed]] = np.inf
+        # Sharp edges are refined where the pixel's surface is known (looked up if need be).
+        sharp &= fast
+        pixels.look_up(solution, maps, rows, width, height, np.flatnonzero(sharp & ~pixels.known))
+        refine |= sharp & (pixels.tri >= 0)
+        radiance = np.maximum(hdri[rows[0]:rows[-1] + 1].reshape(-1, 3), 0.0)
+        d = ratio_change(radiance, e, de, served, e_ref=e_ref, rep=rep)
+        difference[rows[0]:rows[-1] + 1] = d.reshape(-1, width, 3)
+        if window_e is not None and len(pixels.window_index):
+            window_e[pixels.window_rows, pixels.window_cols] = e[pixels.window_index]
+        idx = np.flatnonzero(refine)
+        parts.append(_Refine(rows[0] * width + idx, pixels.tri[idx], pixels.bary[idx], pixels.distance[idx],
+                             spread[idx], pixels.ring[idx]))
+    return _Refine(*(np.concatenate([getattr(p, f) for p in parts]) for f in _Refine.__dataclass_fields__))
+
+
+@dataclass
+class _BandPixels:
+    """What a band's pixels (flat, band-local) are known to see: in the object's window from
+    its trace; elsewhere looked up when needed (`known` marks where it is)."""
+
+    known: np.ndarray
+    hidden: np.ndarray
+    ring: np.ndarray
+    own: np.ndarray  # surface key seen (-1 for nothing)
+    tri: np.ndarray
+    bary: np.ndarray
+    distance: np.ndarray
+    window_index: np.ndarray  # band-local pixels inside the window ...
+    window_rows: np.ndarray  # ... and where the window holds them
+    window_cols: np.ndarray
+    keys: np.ndarray  # the geometry's surface keys
+
+    @classmethod
+    def of(cls, rows: np.ndarray, width: int, window: ObjectWindow | None, keys: np.ndarray) -> _BandPixels:
+        n = len(rows) * width
+        pixels = cls(np.zeros(n, dtype=bool), np.zeros(n, dtype=bool), np.zeros(n, dtype=bool),
+                     np.full(n, -1, dtype=np.int64), np.full(n, -1, dtype=np.int64), np.zeros((n, 2)), np.zeros(n),
+                     np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), keys)
+        if window is None:
+            return pixels
+        f = window.frame
+        h, w = window.hidden.shape
+        inside = np.flatnonzero((rows >= f.row0) & (rows < f.row0 + h))
+        if not len(inside):
+            return pixels
+        cols = np.mod(f.col0 + np.arange(w), width)
+        index = (inside[:, None] * width + cols[None, :]).ravel()
+        wr = np.repeat(rows[inside] - f.row0, w)
+        wc = np.tile(np.arange(w), len(inside))
+        pixels.window_index, pixels.window_rows, pixels.window_cols = index, wr, wc
+        pixels.known[index] = True
+        pixels.hidden[index] = window.hidden[wr, wc]
+        pixels.ring[index] = window.ring[wr, wc]
+        pixels.tri[index] = window.tri[wr, wc]
+        pixels.bary[index] = window.bary[wr, wc]
+        pixels.distance[index] = np.where(pixels.tri[index] >= 0, window.distance[wr, wc], 0.0)
+        pixels.own[index] = np.where(pixels.tri[index] >= 0, keys[np.maximum(pixels.tri[index], 0)], -1)
+        pixels.own[pixels.hidden] = -1
+        return pixels
+
+    def look_up(self, solution: Solution, maps: WorkingMaps, rows: np.ndarray, width: int, height: int,
+                index: np.ndarray) -> None:
+        """Find what the band's pixels `index` see, among their working neighbours' triangles."""
+        if not len(index):
+            return
+        r, c = rows[0] + index // width, index % width
+        near = neighbours(r, c, (height, width), maps)
+        found = surfaces_seen(pixel_directions_at(r, c, (height, width)), near.nearest, solution.geo, maps)
+        self.tri[index], self.bary[index], self.distance[index] = found.tri, found.bary, found.distance
+        self.own[index] = np.where(found.tri >= 0, self.keys[np.maximum(found.tri, 0)], -1)
+        self.known[index] = True
+
+
+@dataclass(frozen=True)
+class _Mixed:
+    """Light of the pixels of mixed cells from the neighbours on their own surface."""
+
+    e: np.ndarray
+    de: np.ndarray
+    served: np.ndarray  # some neighbour on its surface served it
+    needed: np.ndarray  # none did: the pixel is refined
+
+
+def _mixed(solution: Solution, maps: WorkingMaps, pixels: _BandPixels, rows: np.ndarray, width: int,
+           index: np.ndarray, height: int) -> _Mixed:
+    """E and dE of band pixels `index` from the working neighbours that see their surface."""
+    pixels.look_up(solution, maps, rows, width, height, index[~pixels.known[index]])
+    r, c = rows[0] + index // width, index % width
+    near = neighbours(r, c, (height, width), maps)
+    own = pixels.own[index]
+    same = (maps.key[near.index] == own[None, :]) & (own >= 0)[None, :]
+    weight = near.weight * maps.valid[near.index] * same
+    total = weight.sum(axis=0)
+    weight = weight / np.where(total > 0, total, 1.0)[None, :]
+    e = np.einsum("kn,knc->nc", weight, maps.e[near.index])
+    de = np.einsum("kn,knc->nc", weight, maps.de[near.index])
+    ring = pixels.ring[index]
+    served = (total > 0) & ~ring
+    # A pixel whose surface only lights neighbours that are light sources is one itself.
+    emitter = (same & maps.emitter[near.index]).any(axis=0)
+    needed = ~served & ~emitter & (pixels.tri[index] >= 0) | ring & (pixels.tri[index] >= 0)
+    return _Mixed(e, de, served, needed)
+
+
+def _refine(solution: Solution, refine: _Refine, hdri: np.ndarray, difference: np.ndarray,
+            window: ObjectWindow | None, window_e: np.ndarray | None, e_ref: float, rep: Report,
+            callbacks: RunCallbacks) -> None:
+    """Give the pixels to refine their own light (the sharp-edge ones up to the preset's budget)."""
+    needed = np.isinf(refine.spread)
+    optional = np.flatnonzero(~needed)
+    budget = solution.params.refine_pixels
+    keep = needed.copy()
+    keep[optional[np.argsort(-refine.spread[optional], kind="stable")[:budget]]] = True
+    rep.info["refined_pixels"] = {"needed": int(needed.sum()), "sharp_edges": int(min(len(optional), budget)),
+                                  "sharp_edges_left": int(max(0, len(optional) - budget))}
+    for beside in (True, False):
+        chosen = keep & (refine.beside == beside)
+        if chosen.any():
+            _refined_light(solution, refine.pixel[chosen], refine.tri[chosen], refine.bary[chosen],
+                           refine.distance[chosen], hdri, difference, window, window_e, e_ref, rep, callbacks,
+                           per_point=beside)
+
+
+def _refined_light(solution: Solution, pixel: np.ndarray, tri: np.ndarray, bary: np.ndarray, distance: np.ndarray,
+                   hdri: np.ndarray, difference: np.ndarray, window: ObjectWindow | None, window_e: np.ndarray | None,
+                   e_ref: float, rep: Report, callbacks: RunCallbacks, *, per_point: bool) -> None:
+    """Write the change of full-resolution pixels (flat `pixel`, seeing `tri` at `bary` and
+    `distance`) from their own light."""
+    height, width = hdri.shape[:2]
+    rows, cols = np.divmod(pixel, width)
+    room, geo, target = solution.room, solution.geo, solution.target
+    points = pixel_directions_at(rows, cols, (height, width)) * distance[:, None]
+    patch, corners, weights = room.patches.lattice.locate(tri, bary)
+    relit = ~room.emitter[patch]
+    if target.planes:
+        relit &= np.isin(geo.tri_object[tri], target.planes)
+    receiving = Receiving(points=points, normals=geo.normals[tri], tri=tri, bary=bary,
+                          corners=room.receivers.vertex_row[corners], weights=weights, relit=relit)
+    light = light_at(geo, target, receiving, solution.occlusion, room, solution.db, solution.split, solution.params,
+                     callbacks, per_point=per_point)
+    key = "refined_exact_pairs"
+    rep.info[key] = rep.info.get(key, 0) + light.exact_pairs
+    radiance = np.maximum(hdri.reshape(-1, 3)[pixel].astype(np.float64), 0.0)
+    difference.reshape(-1, 3)[pixel] = ratio_change(radiance, light.e, light.de, ~room.emitter[patch], e_ref=e_ref,
+                                                    rep=rep)
+    if window is not None and window_e is not None:
+        wr, wc, inside = window.holds(rows, cols)
+        window_e[wr[inside], wc[inside]] = light.e[inside]
+
+
+def _revealed(solution: Solution, window: ObjectWindow, window_e: np.ndarray, hdri: np.ndarray,
+              revealed: np.ndarray, e_ref: float) -> Revealed:
+    """The window's revealed pixels and its reflectance, at full resolution (float32: the
+    maps span millions of pixels)."""
+    frame = window.frame
+    rows, cols = _window_pixels(window)
+    radiance = np.maximum(hdri[rows, cols], 0.0)
+    keys = solution.target.surface_key.astype(np.int32)
+    seen_tri = np.where(window.on_object, window.object_tri, window.tri)
+    surface_with = np.where(seen_tri >= 0, keys[np.maximum(seen_tri, 0)], -1)
+    del seen_tri
+    surface_without = np.where(window.tri >= 0, keys[np.maximum(window.tri, 0)], -1)
+    distance_with = np.where(window.on_object, window.object_distance, window.distance)
+    finite = np.isfinite(window.distance)
+    maps = PanoramaMaps(surface_with, np.where(np.isfinite(distance_with), distance_with, 0.0), surface_without,
+                        np.where(finite, window.distance, 0.0), window.hidden, frame=frame)
+    del distance_with
+    room_hit = finite & ~window.on_object
+    emitter = np.zeros(window.hidden.shape, dtype=bool)
+    patch, _, _ = solution.room.patches.lattice.locate(window.tri[room_hit], window.bary[room_hit].astype(np.float64))
+    emitter[room_hit] = solution.room.emitter[patch]
+    measured = ~window.hidden & room_hit & ~emitter & ((window_e @ LUMA.astype(np.float32)) > 1e-3 * e_ref)
+    rho = measured_reflectance(radiance.reshape(-1, 3), window_e.reshape(-1, 3), measured.ravel())
+    rho = rho.reshape(radiance.shape).astype(np.float32, copy=False)
+    tri = window.tri[revealed].astype(np.int64)
+    distance = window.distance[revealed].astype(np.float64)
+    directions = pixel_directions_at(rows[revealed], cols[revealed], (frame.height, frame.width))
+    solid = latlong.pixel_solid_angles(frame.width, frame.height)[rows[revealed], 0]
+    footprint = surface_footprint(solid, directions, solution.geo.normals[tri], distance)
+    return Revealed(tri=tri, bary=window.bary[revealed].astype(np.float64), points=directions * distance[:, None],
+                    radiance=radiance[revealed].astype(np.float64), footprint=footprint,
+                    panorama=PanoramaReflectance(rho, measured, maps))

@@ -1,0 +1,108 @@
+"""The part of the full-resolution panorama around the removed object: which pixels show it,
+what they reveal once it is gone, and the surfaces the fill's exemplar is read from."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..geometry import latlong
+from ..geometry.mesh import Geometry
+from ..geometry.planeraster import Frame
+from ..geometry.raycast import trace_panorama
+from .target import Target
+from .working_maps import WorkingMaps, neighbours, surfaces_seen
+
+_PAD = 4  # working pixels the window reaches past what it must hold
+_MAX_PIXELS = 4 << 20  # the largest window (its arrays and the fill's maps take ~120 bytes a pixel)
+_RING = 3  # full-resolution pixels beside the object always get their own light
+_BLOCK_PIXELS = 1 << 19  # pixels looked up at a time (bounds the candidates' temporaries)
+
+
+@dataclass(frozen=True)
+class ObjectWindow:
+    """(h, w) arrays over `frame`: the full-resolution pixels around the object."""
+
+    frame: Frame
+    hidden: np.ndarray  # bool: filled (the object and its silhouette, one pixel wide)
+    ring: np.ndarray  # bool: not hidden, within a few pixels of it
+    on_object: np.ndarray  # bool: the object is the first hit
+    tri: np.ndarray  # int32: what the pixel sees without the object (-1 for nothing)
+    distance: np.ndarray  # float32: its distance (inf for nothing)
+    bary: np.ndarray  # (h, w, 2) float32 barycentric weights of vertices 1 and 2 there
+    object_distance: np.ndarray  # float32: distance of the object's first hit (inf where none)
+    object_tri: np.ndarray  # int32: the object's triangle hit (-1 for none)
+
+    def holds(self, rows: np.ndarray, cols: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Panorama pixels -> this window's (row, column) and whether it holds them."""
+        return self.frame.locate(rows, cols, self.hidden.shape)
+
+
+def object_window(geo: Geometry, target: Target, hidden_working: np.ndarray, cover: np.ndarray | None,
+                  full: tuple[int, int], maps: WorkingMaps) -> ObjectWindow | None:
+    """The window around the pixels the working panorama hides (`hidden_working`, (h, w)) and
+    the directions (N, 3) it must `cover` as well (the fill's exemplar), at most
+    _MAX_PIXELS large, traced at the full resolution `full` (height, width); None when
+    nothing is hidden."""
+    if not hidden_working.any():
+        return None
+    height, width = full
+    h, w = hidden_working.shape
+    wanted = hidden_working.copy()
+    if cover is not None and len(cover):
+        wanted[latlong.uv_to_pixel(*latlong.direction_to_uv(cover), w, h)] = True
+    rows = np.flatnonzero(wanted.any(axis=1))
+    col0, cols = _column_span(wanted.any(axis=0))
+    r0, r1 = max(0, rows[0] - _PAD), min(h, rows[-1] + 1 + _PAD)
+    col0, cols = (0, w) if cols + 2 * _PAD >= w else (col0 - _PAD, cols + 2 * _PAD)
+    scale = height / h
+    # Too large a window is cut back towards the object (the exemplar loses its far cells).
+    shrink = min(1.0, np.sqrt(_MAX_PIXELS / ((r1 - r0) * cols * scale * scale)))
+    if shrink < 1.0:
+        hidden_rows = np.flatnonzero(hidden_working.any(axis=1))
+        centre_r = (hidden_rows[0] + hidden_rows[-1] + 1) / 2
+        half = (r1 - r0) * shrink / 2
+        r0, r1 = max(0, int(centre_r - half)), min(h, int(np.ceil(centre_r + half)))
+        trimmed = int(cols * (1.0 - shrink) / 2)
+        col0, cols = col0 + trimmed, cols - 2 * trimmed
+    row_start, row_stop = int(np.floor(r0 * scale)), int(np.ceil(r1 * scale))
+    col_start = int(np.floor(col0 * scale)) % width
+    ncols = width if cols == w else min(width, int(np.ceil(cols * scale)))
+    window = (row_start, row_stop - row_start, col_start, ncols)
+    on = np.flatnonzero(geo.tri_object == target.index)
+    obj = trace_panorama(geo.triangles[on], width, height, window=window)
+    # float32 and int32: a window of millions of pixels is the largest thing the run holds
+    # besides the panorama and its difference; a metre in float32 is exact to a micron.
+    object_distance = np.where(obj.tri >= 0, obj.distance, np.inf).astype(np.float32)
+    object_tri = np.where(obj.tri >= 0, on[np.maximum(obj.tri, 0)], -1).astype(np.int32)
+    directions = obj.directions
+    shape = obj.tri.shape
+    del obj
+    tri = np.empty(shape, dtype=np.int32)
+    distance = np.empty(shape, dtype=np.float32)
+    bary = np.empty((*shape, 2), dtype=np.float32)
+    cols_full = np.mod(col_start + np.arange(ncols), width)
+    block = max(1, _BLOCK_PIXELS // ncols)
+    for start in range(0, shape[0], block):
+        rows_b = row_start + np.arange(start, min(start + block, shape[0]))
+        near = neighbours(np.repeat(rows_b, ncols), np.tile(cols_full, len(rows_b)), full, maps)
+        seen = surfaces_seen(directions[start:start + len(rows_b)].reshape(-1, 3), near.nearest, geo, maps)
+        tri[start:start + len(rows_b)] = seen.tri.reshape(-1, ncols)
+        distance[start:start + len(rows_b)] = seen.distance.reshape(-1, ncols)
+        bary[start:start + len(rows_b)] = seen.bary.reshape(-1, ncols, 2)
+    on_object = object_distance < distance
+    hidden = latlong.dilate(on_object, 1)
+    ring = latlong.dilate(hidden, _RING) & ~hidden
+    return ObjectWindow(frame=Frame(row_start, col_start, height, width), hidden=hidden, ring=ring,
+                        on_object=on_object, tri=tri, distance=distance, bary=bary, object_distance=object_distance,
+                        object_tri=object_tri)
+
+
+def _column_span(columns: np.ndarray) -> tuple[int, int]:
+    """(first, count) of the shortest circular run of columns holding every True one."""
+    w = len(columns)
+    on = np.flatnonzero(columns)
+    gaps = np.diff(np.concatenate([on, on[:1] + w]))
+    widest = int(gaps.argmax())
+    first = int(on[(widest + 1) % len(on)])
+    return first, w - int(gaps[widest]) + 1
