@@ -43,11 +43,11 @@ def _run(scene: SceneData, quality: str, overrides: dict, compute: Callable[[Sce
     validate(scene)
     params = params_for(quality, **overrides)
     # Negative radiance is not light: the engine reads it as black (`radiance.clamped_rows`),
-    # and those pixels are passed through as they are. The stages read the panorama whole, so
-    # they get a clamped copy.
+    # and those pixels are passed through as they are. A panorama above the working width is
+    # read in bands, clamped as it is read; a smaller one is read whole, so it gets a clamped copy.
     negative = negative_pixels(scene.hdri)
     original = scene.hdri
-    if negative:
+    if negative and scene.hdri.shape[1] <= params.working_width:
         scene = replace(scene, hdri=clamped_rows(scene.hdri, 0, scene.hdri.shape[0]))
     result = compute(scene, params)
     report = dict(result.report)

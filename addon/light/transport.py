@@ -14,10 +14,12 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, replace
+from functools import cached_property
 
 import numpy as np
 
 from ..geometry.occluders import Occluders
+from . import aggregate
 from .formfactor import point_to_triangle
 
 _SEGMENTS_PER_CHUNK = 300_000
@@ -26,11 +28,18 @@ _SEGMENTS_PER_CHUNK = 300_000
 @dataclass(frozen=True)
 class Parts:
     """Senders made of several triangles (clusters of a finely tessellated object): the member
-    triangles, their normals and their sender. Form factors add up over the members."""
+    triangles, their normals and their sender. Form factors add up over the members, near
+    ones exactly and far ones by aggregates (`aggregate`)."""
 
     triangles: np.ndarray  # (T, 3, 3)
     normals: np.ndarray  # (T, 3)
     owner: np.ndarray  # (T,) sender of each member
+
+    @cached_property
+    def hierarchy(self) -> tuple[np.ndarray, aggregate.Hierarchy]:
+        """The senders that have members, and the hierarchy of their members."""
+        senders, owner = np.unique(self.owner, return_inverse=True)
+        return senders, aggregate.hierarchy(self.triangles, self.normals, owner.ravel(), len(senders))
 
 
 @dataclass(frozen=True)
@@ -97,14 +106,16 @@ def make_senders(triangles: np.ndarray, normals: np.ndarray, radiosity: np.ndarr
 def form_factors(points: np.ndarray, normals: np.ndarray, senders: Senders) -> np.ndarray:
     """(R, S) form factors from receivers (R, 3) with normals (R, 3) to the senders, summed over
     the members of senders made of several triangles."""
-    f = point_to_triangle(points, normals, senders.triangles, senders.normals)
     parts = senders.parts
-    if parts is not None and len(parts.owner):
-        order = np.argsort(parts.owner, kind="stable")
-        owner = parts.owner[order]
-        start = np.flatnonzero(np.r_[True, np.diff(owner) > 0])
-        member = point_to_triangle(points, normals, parts.triangles[order], parts.normals[order])
-        f[:, owner[start]] = np.add.reduceat(member, start, axis=1)
+    if parts is None or not len(parts.owner):
+        return point_to_triangle(points, normals, senders.triangles, senders.normals)
+    clustered, tree = parts.hierarchy
+    single = np.ones(len(senders), dtype=bool)
+    single[clustered] = False
+    f = np.zeros((len(points), len(senders)))
+    f[:, single] = point_to_triangle(points, normals, senders.triangles[single], senders.normals[single])
+    f[:, clustered] = aggregate.form_factors(np.asarray(points, dtype=np.float64),
+                                             np.asarray(normals, dtype=np.float64), tree)
     return f
 
 

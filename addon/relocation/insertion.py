@@ -24,6 +24,7 @@ from ..quality import Params, rough
 from ..removal import RemovalResult, Solution, finish, solve, solve_lighting, traced_scene
 from ..removal.sequence import STAGES
 from ..removal.target import object_index
+from ..removal.working import downsample, upsample, working_size
 from ..report import Report
 from ..scene import SceneData
 from .appearance import Carried, carry
@@ -52,6 +53,16 @@ def relocate(scene: SceneData, object_name: str, move: Move, *, planes: list[str
     target = object_index(scene, object_name)
     if not (np.asarray(scene.tri_object) == target).any():
         raise DimredError(f"'{object_name}' has no faces to move")
+    height, width = scene.hdri.shape[:2]
+    size = working_size(width, height, max_width=params.working_width)
+    if size != (width, height):
+        # A relocation moves the object's own pixels, which the working copy holds at its
+        # resolution: the whole change is solved there and its difference upsampled.
+        small = relocate(replace(scene, hdri=downsample(scene.hdri, *size)), object_name, move, planes=planes,
+                         params=params, callbacks=callbacks)
+        report = {**small.report, "working_resolution": list(size)}
+        return RemovalResult(difference=upsample(small.difference, height, width),
+                             hidden_mask=upsample(small.hidden_mask, height, width), report=report, hdri=scene.hdri)
     passes = params.insertion_passes
     if passes < 1:
         raise DimredError(f"insertion_passes must be at least 1, got {passes}")

@@ -18,6 +18,7 @@ from ..callbacks import RunCallbacks
 from ..geometry import latlong
 from ..geometry.planeraster import PlaneRaster, build_raster
 from ..light.radiosity import LUMA
+from ..radiance import clamped_rows
 from ..report import Report
 from ..synthesis.plane_fill import PanoramaMaps, PanoramaReflectance
 from .compose import ratio_change, reference_irradiance
@@ -169,7 +170,7 @@ def _upsample(solution: Solution, maps: WorkingMaps, window: ObjectWindow | None
         sharp &= fast
         pixels.look_up(solution, maps, rows, width, height, np.flatnonzero(sharp & ~pixels.known))
         refine |= sharp & (pixels.tri >= 0)
-        radiance = np.maximum(hdri[rows[0]:rows[-1] + 1].reshape(-1, 3), 0.0)
+        radiance = clamped_rows(hdri, rows[0], rows[-1] + 1).reshape(-1, 3)
         d = ratio_change(radiance, e, de, served, e_ref=e_ref, rep=rep)
         difference[rows[0]:rows[-1] + 1] = d.reshape(-1, width, 3)
         if window_e is not None and len(pixels.window_index):

@@ -51,20 +51,18 @@ def object_window(geo: Geometry, target: Target, hidden_working: np.ndarray, cov
     wanted = hidden_working.copy()
     if cover is not None and len(cover):
         wanted[latlong.uv_to_pixel(*latlong.direction_to_uv(cover), w, h)] = True
-    rows = np.flatnonzero(wanted.any(axis=1))
-    col0, cols = _column_span(wanted.any(axis=0))
-    r0, r1 = max(0, rows[0] - _PAD), min(h, rows[-1] + 1 + _PAD)
-    col0, cols = (0, w) if cols + 2 * _PAD >= w else (col0 - _PAD, cols + 2 * _PAD)
+    must = _span(hidden_working, _PAD)
+    want = _span(wanted, _PAD)
+    # The wanted columns as a run that starts left of the object's own (they hold them).
+    left = (must[2] - want[2]) % w if want[3] < w else (w - must[3]) // 2
+    want = (want[0], want[1], must[2] - left, want[3])
     scale = height / h
-    # Too large a window is cut back towards the object (the exemplar loses its far cells).
-    shrink = min(1.0, np.sqrt(_MAX_PIXELS / ((r1 - r0) * cols * scale * scale)))
-    if shrink < 1.0:
-        hidden_rows = np.flatnonzero(hidden_working.any(axis=1))
-        centre_r = (hidden_rows[0] + hidden_rows[-1] + 1) / 2
-        half = (r1 - r0) * shrink / 2
-        r0, r1 = max(0, int(centre_r - half)), min(h, int(np.ceil(centre_r + half)))
-        trimmed = int(cols * (1.0 - shrink) / 2)
-        col0, cols = col0 + trimmed, cols - 2 * trimmed
+    # Too large a window is cut back towards the object (the exemplar loses its far cells);
+    # the object and its surroundings always stay in.
+    for t in np.linspace(1.0, 0.0, 21):
+        r0, r1, col0, cols = (round(m + t * (x - m)) for m, x in zip(must, want, strict=True))
+        if (r1 - r0) * cols * scale * scale <= _MAX_PIXELS:
+            break
     row_start, row_stop = int(np.floor(r0 * scale)), int(np.ceil(r1 * scale))
     col_start = int(np.floor(col0 * scale)) % width
     ncols = width if cols == w else min(width, int(np.ceil(cols * scale)))
@@ -96,6 +94,16 @@ def object_window(geo: Geometry, target: Target, hidden_working: np.ndarray, cov
     return ObjectWindow(frame=Frame(row_start, col_start, height, width), hidden=hidden, ring=ring,
                         on_object=on_object, tri=tri, distance=distance, bary=bary, object_distance=object_distance,
                         object_tri=object_tri)
+
+
+def _span(mask: np.ndarray, pad: int) -> tuple[int, int, int, int]:
+    """(first row, end row, first column, columns) of the working pixels of `mask` and `pad`
+    more around; the columns wrap (all of them when the span would close the circle)."""
+    h, w = mask.shape
+    rows = np.flatnonzero(mask.any(axis=1))
+    col0, cols = _column_span(mask.any(axis=0))
+    col0, cols = (0, w) if cols + 2 * pad >= w else (col0 - pad, cols + 2 * pad)
+    return max(0, int(rows[0]) - pad), min(h, int(rows[-1]) + 1 + pad), col0, cols
 
 
 def _column_span(columns: np.ndarray) -> tuple[int, int]:

@@ -20,6 +20,8 @@ import contextlib
 import functools
 import os
 import secrets
+import shutil
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -114,12 +116,13 @@ def run(request: RemovalRequest, callbacks: RunCallbacks = NO_CALLBACKS) -> Remo
     difference, report = result.difference, result.report
     del result
     callbacks.check()
+    _progress(callbacks, "writing", 1.0)
     return RemovalOutcome(report=report, staged=_write(request, difference))
 
 
-def _progress(callbacks: RunCallbacks, stage: str) -> None:
+def _progress(callbacks: RunCallbacks, stage: str, fraction: float = 0.0) -> None:
     if callbacks.progress is not None:
-        callbacks.progress(stage, 0.0)
+        callbacks.progress(stage, fraction)
 
 
 def _quick(request: RemovalRequest, panorama: np.ndarray, callbacks: RunCallbacks) -> Previews:
@@ -194,20 +197,24 @@ def _pixels(layer: Layer, shape: tuple[int, ...]) -> np.ndarray:
 
 
 def _write(request: RemovalRequest, difference: np.ndarray) -> Staged:
-    """Stage this removal's own difference, then the layer (the base added to the same array),
-    and keep the own difference's small copy for the runs that will build on it."""
+    """Stage this removal's own difference, then the layer (the base added to the same array,
+    or, without a base, the own file copied: the encoding is the slow part), and keep the own
+    difference's small copy for the runs that will build on it."""
     staged = Staged()
     try:
+        own = ""
         if request.own_path:
-            temporary = _stage(staged, request.own_path, difference)
+            own = _stage(staged, request.own_path, lambda temporary: write_exr(temporary, difference))
             if request.cache_folder:
                 small_copy.store(request.own_path, small_copy.of_image(difference), request.cache_folder,
-                                 stat=os.stat(temporary))
-        if request.layer_path:
+                                 stat=os.stat(own))
+        if request.layer_path and own and not request.base:
+            _stage(staged, request.layer_path, lambda temporary: shutil.copyfile(own, temporary))
+        elif request.layer_path:
             # In place: the engine's array is no one else's, and the own file is written.
             for layer in request.base:
                 difference += _pixels(layer, difference.shape)
-            _stage(staged, request.layer_path, difference)
+            _stage(staged, request.layer_path, lambda temporary: write_exr(temporary, difference))
     except OSError as error:
         staged.discard()
         raise DimredError(f"cannot write the difference image: {error.strerror or error}") from None
@@ -217,10 +224,11 @@ def _write(request: RemovalRequest, difference: np.ndarray) -> Staged:
     return staged
 
 
-def _stage(staged: Staged, path: str, image: np.ndarray) -> str:
+def _stage(staged: Staged, path: str, write: Callable[[str], object]) -> str:
+    """`write(temporary)` the file that `staged` will move to `path`; the temporary name."""
     os.makedirs(os.path.dirname(path) or ".", exist_ok=True)
     folder, name = os.path.split(path)
     temporary = os.path.join(folder, f".{name}.{secrets.token_hex(4)}.staged.exr")
     staged.moves.append((temporary, path))
-    write_exr(temporary, image)
+    write(temporary)
     return temporary

@@ -21,6 +21,7 @@ import os
 import shutil
 import tempfile
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
@@ -244,7 +245,7 @@ class RemovalSession:
         self.worker = Worker(self._task()).start()
         _running.append(self)
 
-    def _task(self):
+    def _task(self) -> Callable[[RunCallbacks], RemovalOutcome]:
         """The run as a function of its callbacks: first waiting for the small copy of the
         panorama if a thread is making it (its first preview needs it, and reading the file
         meanwhile would read it twice)."""

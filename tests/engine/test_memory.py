@@ -31,13 +31,6 @@ def test_required_bytes_grow_with_the_pixels_over_the_solve():
         memory.required_bytes(8, 4, quality="best")
 
 
-def test_the_product_targets_fit_the_budgets():
-    # 8192 x 4096 in 3 GB and 16384 x 8192 in 8 GB, at every preset.
-    for quality in memory.SOLVE_BYTES:
-        assert memory.required_bytes(8192, 4096, quality=quality) <= 3 * GB
-        assert memory.required_bytes(16384, 8192, quality=quality) <= 8 * GB
-
-
 def test_a_run_that_does_not_fit_is_refused_with_what_to_do():
     needed = memory.required_bytes(16384, 8192, quality="balanced")
     with pytest.raises(DimredError) as refused:

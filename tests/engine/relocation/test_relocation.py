@@ -179,3 +179,15 @@ def test_the_number_of_insertion_passes_is_a_parameter(tiny):
     assert change < 0.5 * np.abs(three.difference).sum()
     with pytest.raises(DimredError, match="insertion_passes must be at least 1"):
         relocate_object(tiny, "Box", Move(-90.0, 1.0), quality="draft", insertion_passes=0)
+
+
+def test_above_the_working_resolution_the_move_is_solved_on_the_working_copy(tiny):
+    small = relocate_object(tiny, "Box", Move(-90.0, 1.0), quality="draft")
+    big_scene = replace(tiny, hdri=np.repeat(np.repeat(tiny.hdri, 2, axis=0), 2, axis=1))
+    big = relocate_object(big_scene, "Box", Move(-90.0, 1.0), quality="draft", working_width=128)
+    assert big.report["working_resolution"] == [128, 64]
+    assert big.difference.shape == (128, 256, 3) and big.hidden_mask.shape == (128, 256)
+    # The working copy is the small panorama itself: its change, interpolated over 2 x 2 pixels.
+    pooled = big.difference.reshape(64, 2, 128, 2, 3).mean(axis=(1, 3))
+    assert np.abs(pooled - small.difference).mean() < 0.2 * np.abs(small.difference).mean()
+    assert np.array_equal(big.hidden_mask[::2, ::2], small.hidden_mask)
