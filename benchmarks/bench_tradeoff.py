@@ -5,10 +5,17 @@ time) the removal runs on the cached ground-truth scenes; the script measures th
 ratio against the Cycles truth (region A, `scenes.metrics.lighting_error_ratio`) and its Monte
 Carlo noise floor (`noise_floor`: the error left when the input is scaled by the 3x3 box-filtered
 ratio of truth to input), the hidden region's scores, and the seconds of the lighting stages and
-of the synthesis. The panorama resolution is swept on the 0.5 m box (256x128 and 1024x512).
+of the synthesis, the CPU seconds of the process (steadier than the wall clock on a shared
+machine) and its peak resident memory during the removal (Linux only; Blender and the loaded
+scene included). The panorama resolution is swept on the 0.5 m box (256x128 and 1024x512).
 It writes `out/tradeoff/tradeoff.csv` and `tradeoff.md` (a row per setting, means over the
 scenes, the Pareto front of error against total seconds marked) and prints the Markdown;
 `benchmarks/plot_tradeoff.py` draws the plot from the CSV.
+
+`--settings` picks the sweep's settings: labels of SETTINGS or `PRESET[+NAME=VALUE...]`
+(`balanced+sender_samples=6+reach=0.05`); `--wide SCENE:SAMPLES,...` and `--wide-settings`
+choose what runs at `--width` (an empty `--scenes` skips the 256x128 sweep), e.g.
+`--scenes "" --wide basic_box:16,bright_lamp:16,demo:32 --wide-settings balanced,final`.
 """
 from __future__ import annotations
 
@@ -51,7 +58,39 @@ SETTINGS = (
 )
 RESOLUTION_SETTINGS = ("draft", "balanced")
 FIELDS = ("setting", "scenes", "width", "lighting_ratio", "noise_floor", "ratio_over_floor", "hidden_mean",
-          "hidden_detail", "object_shadow", "lighting_s", "synthesis_s", "total_s", "pareto")
+          "hidden_detail", "object_shadow", "lighting_s", "synthesis_s", "total_s", "cpu_s", "peak_gb", "pareto")
+_KB = 1024
+
+
+def setting(text: str) -> tuple[str, str, dict]:
+    """(label, preset, overrides) of a label of SETTINGS or of `PRESET[+NAME=VALUE...]`."""
+    known = {s[0]: s for s in SETTINGS}
+    if text in known:
+        return known[text]
+    preset, *pairs = text.split("+")
+    overrides = {}
+    for pair in pairs:
+        name, _, value = pair.partition("=")
+        overrides[name] = int(value) if value.lstrip("-").isdigit() else float(value)
+    return text, preset, overrides
+
+
+def _reset_peak() -> None:
+    """Start a new peak of resident memory (writing 5 to clear_refs resets VmHWM on Linux)."""
+    try:
+        Path("/proc/self/clear_refs").write_text("5")
+    except OSError:
+        pass
+
+
+def _peak_gb() -> float:
+    """Peak resident memory since `_reset_peak`, in GB; NaN where /proc does not say."""
+    try:
+        lines = Path("/proc/self/status").read_text().splitlines()
+    except OSError:
+        return float("nan")
+    peak = [int(line.split()[1]) for line in lines if line.startswith("VmHWM:")]
+    return peak[0] * _KB / 1e9 if peak else float("nan")
 
 
 def _measure(scene_name: str, width: int, samples: int, settings) -> list[dict]:
@@ -69,9 +108,11 @@ def _measure(scene_name: str, width: int, samples: int, settings) -> list[dict]:
     floor = metrics.noise_floor(inp, truth, mask)
     rows = []
     for label, preset, overrides in settings:
-        t0 = time.perf_counter()
+        _reset_peak()
+        t0, c0 = time.perf_counter(), time.process_time()
         result = remove_object(scene, spec.remove, quality=preset, **overrides)
-        total = time.perf_counter() - t0
+        total, cpu = time.perf_counter() - t0, time.process_time() - c0
+        peak = _peak_gb()
         seconds = result.report["seconds"]
         hidden = metrics.hidden_region_scores(inp, result.edited, truth, mask)
         synthesis = seconds.get("synthesis", 0.0)
@@ -80,8 +121,10 @@ def _measure(scene_name: str, width: int, samples: int, settings) -> list[dict]:
                          noise_floor=floor,
                          hidden_mean=hidden["mean_ratio"], hidden_detail=hidden["detail_ratio"],
                          object_shadow=hidden["object_shadow_ratio"], lighting_s=total - synthesis,
-                         synthesis_s=synthesis, total_s=total))
-        print(f"  {scene_name} {width}: {label}: ratio {rows[-1]['lighting_ratio']:.3f}, {total:.1f} s", flush=True)
+                         synthesis_s=synthesis, total_s=total, cpu_s=cpu, peak_gb=peak))
+        del result
+        print(f"  {scene_name} {width}: {label}: ratio {rows[-1]['lighting_ratio']:.3f}, {total:.1f} s, "
+              f"{cpu:.1f} cpu s, {peak:.2f} GB", flush=True)
     return rows
 
 
@@ -105,30 +148,38 @@ def pareto(rows: list[dict], *, cost: str = "total_s", error: str = "lighting_ra
 
 
 def markdown(rows: list[dict]) -> str:
-    head = ("| setting | width | lighting error ratio | noise floor | ratio / floor | hidden mean | hidden detail "
-            "| object + shadow | lighting s | synthesis s | total s | Pareto |")
-    lines = [head, "|---" * 12 + "|"]
+    head = ("| setting | scenes | width | lighting error ratio | noise floor | ratio / floor | hidden mean "
+            "| hidden detail | object + shadow | lighting s | synthesis s | total s | CPU s | peak GB | Pareto |")
+    lines = [head, "|---" * 15 + "|"]
     for r in rows:
-        lines.append(f"| {r['setting']} | {r['width']} | {r['lighting_ratio']:.3f} | {r['noise_floor']:.3f} | "
-                     f"{r['ratio_over_floor']:.2f} | {r['hidden_mean']:.3f} | {r['hidden_detail']:.2f} | "
-                     f"{r['object_shadow']:.3f} | {r['lighting_s']:.2f} | {r['synthesis_s']:.2f} | "
-                     f"{r['total_s']:.2f} | {'yes' if r['pareto'] else ''} |")
+        lines.append(f"| {r['setting']} | {r['scenes']} | {r['width']} | {r['lighting_ratio']:.3f} | "
+                     f"{r['noise_floor']:.3f} | {r['ratio_over_floor']:.2f} | {r['hidden_mean']:.3f} | "
+                     f"{r['hidden_detail']:.2f} | {r['object_shadow']:.3f} | {r['lighting_s']:.2f} | "
+                     f"{r['synthesis_s']:.2f} | {r['total_s']:.2f} | {r['cpu_s']:.2f} | {r['peak_gb']:.2f} | "
+                     f"{'yes' if r['pareto'] else ''} |")
     return "\n".join(lines)
 
 
 def main() -> None:
     ap = arguments(__doc__)
     ap.add_argument("--out", default="out/tradeoff")
-    ap.add_argument("--scenes", default=",".join(SCENES))
+    ap.add_argument("--scenes", default=",".join(SCENES), help="the 256x128 sweep's scenes ('' for none)")
+    ap.add_argument("--settings", default=",".join(s[0] for s in SETTINGS),
+                    help="the sweep's settings: labels of SETTINGS or PRESET[+NAME=VALUE...]")
+    ap.add_argument("--wide", default="basic_box:16", help="SCENE:SAMPLES,... measured at --width")
+    ap.add_argument("--wide-settings", default=",".join(RESOLUTION_SETTINGS), help="settings measured at --width")
     args = ap.parse_args()
     started = time.perf_counter()
     rows: list[dict] = []
-    for name in args.scenes.split(","):
-        rows += _measure(name, 256, 64, SETTINGS)
+    for name in filter(None, args.scenes.split(",")):
+        rows += _measure(name, 256, 64, [setting(t) for t in args.settings.split(",")])
     table = _mean_rows(rows, 256)
     pareto(table)
-    big = [s for s in SETTINGS if s[0] in RESOLUTION_SETTINGS]
-    wide = _measure("basic_box", 1024, 16, big)
+    wide = []
+    for item in filter(None, args.wide.split(",")):
+        name, _, samples = item.partition(":")
+        wide += _measure(name, args.width, int(samples or args.samples),
+                         [setting(t) for t in args.wide_settings.split(",")])
     for row in wide:
         row["ratio_over_floor"] = row["lighting_ratio"] / row["noise_floor"]
         row["pareto"] = False
@@ -139,7 +190,8 @@ def main() -> None:
         writer.writeheader()
         for row in table + wide:
             writer.writerow({k: (f"{v:.4f}" if isinstance(v, float) else v) for k, v in row.items()})
-    text = (f"Means over {args.scenes} at 256x128 (64 spp), then the 0.5 m box at 1024x512 (16 spp); "
+    text = (f"Means over {args.scenes or 'no scenes'} at 256x128 (64 spp), then {args.wide or 'nothing'} at "
+            f"{args.width}x{args.width // 2} (SCENE:spp); "
             f"{time.perf_counter() - started:.0f} s in all.\n\n" + markdown(table + wide) + "\n")
     (out / "tradeoff.md").write_text(text)
     print(text)

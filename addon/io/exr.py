@@ -30,10 +30,13 @@ import OpenEXR
 
 from ..errors import DimredError
 
-#: Rows per band: a multiple of the lines one chunk holds under every scanline compression (1,
-#: 16, 32 or 256) and of the usual tile heights, so that no chunk is decoded twice. A band of a
-#: 16384-wide float32 RGB image is 50 MB.
+#: The most rows per band. The library holds Python's interpreter lock while it encodes or
+#: decodes a band, which stalls Blender's interface when the worker thread reads or writes, so
+#: a band holds about _BAND_PIXELS pixels (0.03 s); its rows are a multiple of the lines one
+#: chunk holds (16 for ZIP, which is written; 32 for PIZ, B44 and DWAA, read), so that no chunk
+#: is decoded twice except under DWAB's 256.
 BAND_ROWS = 256
+_BAND_PIXELS = 1 << 18
 
 _FLOAT = Imath.PixelType(Imath.PixelType.FLOAT)
 _ZIP = Imath.Compression(Imath.Compression.ZIP_COMPRESSION)
@@ -196,7 +199,7 @@ def _read_bands(path: str, part: _ColourPart, rgb: np.ndarray) -> None:
     """Fill `rgb` from the file's first part, converted to float32 by the library, band by band."""
     source = OpenEXR.InputFile(path)
     try:
-        for start, stop in _bands(part.height):
+        for start, stop in _bands(part.height, part.width, chunk=32):
             _read_band(source, part, rgb[start:stop], part.top + start)
     finally:
         source.close()
@@ -223,7 +226,7 @@ def _read_whole(path: str, part: _ColourPart, rgb: np.ndarray) -> None:
 def _write_bands(path: str, header: dict, height: int, width: int, rows: Callable[[int, int], np.ndarray]) -> None:
     target = OpenEXR.OutputFile(path, header)
     try:
-        for start, stop in _bands(height):
+        for start, stop in _bands(height, width, chunk=16):
             target.writePixels(_planes(rows, start, stop, width), stop - start)
     finally:
         target.close()
@@ -253,9 +256,10 @@ def _check_complete(path: str, temp_path: str, height: int) -> None:
         written.close()
 
 
-def _bands(height: int) -> Iterator[tuple[int, int]]:
-    for start in range(0, height, BAND_ROWS):
-        yield start, min(start + BAND_ROWS, height)
+def _bands(height: int, width: int, *, chunk: int) -> Iterator[tuple[int, int]]:
+    rows = min(BAND_ROWS, max(chunk, _BAND_PIXELS // max(width, 1) // chunk * chunk))
+    for start in range(0, height, rows):
+        yield start, min(start + rows, height)
 
 
 def _library_call(path: str, verb: str, call: Callable[[], _T], errors: tuple[type[Exception], ...]) -> _T:

@@ -16,11 +16,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..geometry.solid import in_frame, principal_frame
 from .formfactor import paired_point_to_triangle
 
 BRANCH = 4  # groups of BRANCH, BRANCH^2, ... member triangles, each group made of BRANCH smaller ones
 FAR = 6.0  # a point patch beyond this many times its radius
 _RECEIVERS = 256  # receivers taken at once: bounds the (receiver, group) pairs held
+_HORIZON = 1e-9  # height over a receiver's tangent plane below which nothing is received (as `formfactor`)
 
 
 @dataclass(frozen=True)
@@ -29,11 +31,12 @@ class Aggregates:
 
     centre: np.ndarray  # (n, 3) area-weighted centroid
     radius: np.ndarray  # (n,) of the ball around the centre holding every vertex
-    box_centre: np.ndarray  # (n, 3) centre of the bounding box
+    box_centre: np.ndarray  # (n, 3) centre of the bounding box in the hierarchy's frame
     half: np.ndarray  # (n, 3) half its extent
     vector: np.ndarray  # (n, 3) vector area: sum of area times unit normal
     axis: np.ndarray  # (n, 3) unit mean normal (zero when the normals cancel)
     spread: np.ndarray  # (n,) largest distance of a member's normal from the axis
+    offsets: np.ndarray  # (n, 2) least and greatest axis . vertex (a flat run's plane, twice)
 
 
 @dataclass(frozen=True)
@@ -44,6 +47,7 @@ class Hierarchy:
 
     triangles: np.ndarray  # (T, 3, 3) the members, by sender, then in space-filling order
     normals: np.ndarray  # (T, 3) their unit normals (the side they send to)
+    frame: np.ndarray  # (3, 3) rows: the axes the boxes are taken along (`solid.principal_frame`)
     levels: tuple[Aggregates, ...]
     children: tuple[np.ndarray, ...]  # per level (n + 1,): first row of each in the next level (or member)
     sender: tuple[np.ndarray, ...]  # per level (n,): the sender each row belongs to
@@ -64,18 +68,21 @@ def hierarchy(triangles: np.ndarray, normals: np.ndarray, owner: np.ndarray, cou
     for size in sizes:
         per_sender = -(-np.diff(first) // size)
         row_of.append(np.concatenate([[0], np.cumsum(per_sender)])[owner] + rank // size)
+    frame = principal_frame(triangles)
+    framed = in_frame(triangles, frame)
     levels, children, sender = [], [], []
     for level, rows in enumerate(row_of):
         starts = np.searchsorted(rows, np.arange(rows[-1] + 2))
-        levels.append(_aggregates(triangles, normals, starts))
+        levels.append(_aggregates(triangles, framed, normals, starts))
         sender.append(owner[starts[:-1]])
         below = row_of[level + 1] if level + 1 < len(row_of) else np.arange(len(owner))
         children.append(np.append(below[starts[:-1]], below[-1] + 1))
-    return Hierarchy(triangles, normals, tuple(levels), tuple(children), tuple(sender), owner)
+    return Hierarchy(triangles, normals, frame, tuple(levels), tuple(children), tuple(sender), owner)
 
 
-def _aggregates(triangles: np.ndarray, normals: np.ndarray, starts: np.ndarray) -> Aggregates:
-    """The aggregates of the contiguous runs of triangles starting at starts[:-1]."""
+def _aggregates(triangles: np.ndarray, framed: np.ndarray, normals: np.ndarray, starts: np.ndarray) -> Aggregates:
+    """The aggregates of the contiguous runs of triangles starting at starts[:-1] (`framed`:
+    the triangles in the hierarchy's frame, for the boxes)."""
     first = starts[:-1]
     cross = np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0])
     area = 0.5 * np.linalg.norm(cross, axis=1)
@@ -83,15 +90,18 @@ def _aggregates(triangles: np.ndarray, normals: np.ndarray, starts: np.ndarray) 
     centre = np.add.reduceat(area[:, None] * triangles.mean(axis=1), first) / np.maximum(total, 1e-300)[:, None]
     run = np.repeat(np.arange(len(first)), np.diff(starts))
     reach = np.linalg.norm(triangles - centre[run, None, :], axis=2).max(axis=1)
-    lo, hi = np.minimum.reduceat(triangles.min(axis=1), first), np.maximum.reduceat(triangles.max(axis=1), first)
+    lo, hi = np.minimum.reduceat(framed.min(axis=1), first), np.maximum.reduceat(framed.max(axis=1), first)
     vector = np.add.reduceat(area[:, None] * normals, first)
     length = np.linalg.norm(vector, axis=1)
     has_axis = length > 1e-12 * total
     axis = np.where(has_axis[:, None], vector / np.maximum(length, 1e-300)[:, None], 0.0)
     # A run whose normals cancel has no axis: the spread of 2 keeps it from ever counting as a point patch.
     spread = np.where(has_axis, np.maximum.reduceat(np.linalg.norm(normals - axis[run], axis=1), first), 2.0)
+    along = np.einsum("tkc,tc->tk", triangles, axis[run])
+    offsets = np.stack([np.minimum.reduceat(along.min(axis=1), first), np.maximum.reduceat(along.max(axis=1), first)],
+                       axis=1)
     return Aggregates(centre, np.maximum.reduceat(reach, first), 0.5 * (lo + hi), 0.5 * (hi - lo), vector, axis,
-                      spread)
+                      spread, offsets)
 
 
 def _morton(points: np.ndarray) -> np.ndarray:
@@ -111,10 +121,11 @@ def form_factors(points: np.ndarray, normals: np.ndarray, h: Hierarchy) -> np.nd
     out = np.zeros((len(points), count))
     for r0 in range(0, len(points), _RECEIVERS):
         x, n = points[r0 : r0 + _RECEIVERS], normals[r0 : r0 + _RECEIVERS]
+        xf, nf = in_frame(x, h.frame), in_frame(n, h.frame)
         f = np.zeros(len(x) * count)
         rows, items = np.repeat(np.arange(len(x)), count), np.tile(np.arange(count), len(x))
         for agg, children, sender in zip(h.levels, h.children, h.sender, strict=True):
-            value, near = _point_patches(x[rows], n[rows], agg, items)
+            value, near = _point_patches(x[rows], n[rows], xf[rows], nf[rows], agg, items)
             f += np.bincount(rows * count + sender[items], value, minlength=f.size)
             rows, items = _expand(rows[near], items[near], children)
         exact = paired_point_to_triangle(x[rows], n[rows], h.triangles[items], h.normals[items])
@@ -123,25 +134,34 @@ def form_factors(points: np.ndarray, normals: np.ndarray, h: Hierarchy) -> np.nd
     return out
 
 
-def _point_patches(x: np.ndarray, n: np.ndarray, agg: Aggregates, k: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Pairs of receivers x (P, 3) with unit normals n (P, 3) and aggregates k (P,): the form
+def _point_patches(x: np.ndarray, n: np.ndarray, xf: np.ndarray, nf: np.ndarray, agg: Aggregates, k: np.ndarray
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """Pairs of receivers x (P, 3) with unit normals n (P, 3) (xf, nf: in the hierarchy's
+    frame) and aggregates k (P,): the form
     factor (P,) where the aggregate is a point patch for the receiver (0 where it sends
-    nothing) and (P,) where it is neither, so it must be taken by its parts. The heights over
-    the receiver's plane and in front of the members' take the bounding box (a flat face's
-    is flat) and the spread of the normals."""
+    nothing) and (P,) where it is neither, so it must be taken by its parts.
+
+    The members' heights over the receiver's tangent plane are bounded by the aggregate's
+    ball and box, the receiver's heights in front of the members' planes by their offsets
+    along the axis and the spread of their normals (exact for a flat run)."""
     v = x - agg.centre[k]
     d2 = np.einsum("ij,ij->i", v, v)
     d = np.sqrt(d2)
-    to_box = agg.box_centre[k] - x
-    half = agg.half[k]
-    height = np.einsum("ij,ij->i", n, to_box)  # of the box centre over the receiver's tangent plane
-    height_reach = np.einsum("ij,ij->i", np.abs(n), half)
-    axis = agg.axis[k]
-    facing = -np.einsum("ij,ij->i", axis, to_box)  # of the receiver in front of the box centre
-    facing_reach = np.einsum("ij,ij->i", np.abs(axis), half) + agg.spread[k] * (d + agg.radius[k])
-    nothing = (height + height_reach <= 0.0) | (facing + facing_reach <= 0.0)
-    point = (height - height_reach >= 0.0) & (facing - facing_reach > 0.0) & (d > FAR * agg.radius[k])
-    flux = -np.einsum("ij,ij->i", n, v) * np.einsum("ij,ij->i", agg.vector[k], v)
+    radius = agg.radius[k]
+    over_centre = -np.einsum("ij,ij->i", n, v)
+    over_box = np.einsum("ij,ij->i", nf, agg.box_centre[k] - xf)
+    box_reach = np.einsum("ij,ij->i", np.abs(nf), agg.half[k])
+    highest = np.minimum(over_centre + radius, over_box + box_reach)
+    lowest = np.maximum(over_centre - radius, over_box - box_reach)
+    ahead = np.einsum("ij,ij->i", agg.axis[k], x)
+    turn = agg.spread[k] * (d + radius)
+    nearest = ahead - agg.offsets[k, 1] - turn
+    farthest = ahead - agg.offsets[k, 0] + turn
+    # The contour formula clips at _HORIZON: members no higher send nothing there either, and
+    # one touching the horizon loses only a sliver to it.
+    nothing = (highest <= _HORIZON) | (farthest <= 0.0)
+    point = (lowest >= -_HORIZON) & (nearest > 0.0) & (d > FAR * radius)
+    flux = over_centre * np.einsum("ij,ij->i", agg.vector[k], v)
     value = np.divide(flux, np.pi * d2 * d2, out=np.zeros(len(v)), where=point)
     return value, ~(nothing | point)
 

@@ -32,14 +32,15 @@ def ratio_change(radiance: np.ndarray, e: np.ndarray, de: np.ndarray, apply: np.
     lamp's glare or a model error would otherwise turn into a huge relative change); a change
     that would make the radiance negative is clamped to black."""
     dark = (e @ LUMA) <= 1e-6 * max(e_ref, 1e-30)
-    rep.guard("irradiance_near_zero_pixels", int((apply & dark & (np.abs(de) @ LUMA > 0)).sum()))
+    rep.guard("irradiance_near_zero_pixels", np.count_nonzero(apply & dark & ((np.abs(de) @ LUMA) > 0)))
     apply = apply & ~dark
     e = np.maximum(e, 1e-30)
-    implied = np.pi * radiance / e
-    over = implied > RHO_MAX
-    rep.guard("reflectance_clamped_pixels", int((apply & over.any(axis=1)).sum()))
-    e_eff = np.where(over, np.pi * radiance / RHO_MAX, e)
-    d = np.where(apply[:, None], radiance * de / np.maximum(e_eff, 1e-30), 0.0)
-    negative = radiance + d < 0.0
-    rep.guard("negative_radiance_clamped", int(negative.any(axis=1).sum()))
-    return np.where(negative, -radiance, d)
+    # The E that implies a reflectance of RHO_MAX: pi L / E > RHO_MAX wherever E is below it.
+    floor = radiance * (np.pi / RHO_MAX)
+    over = floor > e
+    rep.guard("reflectance_clamped_pixels", np.count_nonzero(apply & (over[:, 0] | over[:, 1] | over[:, 2])))
+    d = radiance * de / np.maximum(e, floor)
+    d[~apply] = 0.0
+    negative = d < -radiance
+    rep.guard("negative_radiance_clamped", np.count_nonzero(negative[:, 0] | negative[:, 1] | negative[:, 2]))
+    return np.maximum(d, -radiance)

@@ -130,10 +130,12 @@ def remove(scene: SceneData, object_name: str, *, planes: list[str] | tuple[str,
     params = params or Params()
     height, width = scene.hdri.shape[:2]
     size = working_size(width, height, max_width=params.working_width)
-    rep = Report(callbacks.progress, stages=STAGES + (size != (width, height)))
-    if size == (width, height):
-        return finish(solve(scene, object_name, planes, params, rep, callbacks), rep, callbacks)
+    full_size = size != (width, height)
+    # Above the working width the compose stage gives way to downsample, upsample and refine.
+    rep = Report(callbacks.progress, stages=STAGES + 2 * full_size)
     rep.info["working_resolution"] = list(size)
+    if not full_size:
+        return finish(solve(scene, object_name, planes, params, rep, callbacks), rep, callbacks)
     with rep.stage("downsample"):
         working = replace(scene, hdri=downsample(scene.hdri, *size))
     solution = solve(working, object_name, planes, params, rep, callbacks)

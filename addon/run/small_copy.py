@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..geometry.resample import resample_axis
 from ..io.exr import read_exr
 
 PREVIEW_WIDTH = 1024
@@ -33,50 +34,11 @@ def preview_shape(height: int, width: int, *, limit: int = PREVIEW_WIDTH) -> tup
 
 
 def resample(image: np.ndarray, height: int, width: int) -> np.ndarray:
-    """(height, width, C) float32 lat-long `image` resampled: area averages along an axis that
-    shrinks, linear interpolation along one that grows (wrapping round the u seam, clamped at
-    the poles)."""
+    """(height, width, C) float32 lat-long `image` resampled (`geometry.resample`)."""
     out = np.asarray(image, dtype=np.float32)
     for axis, size in ((0, height), (1, width)):
-        if size < out.shape[axis]:
-            out = _average(out, size, axis)
-        elif size > out.shape[axis]:
-            out = _interpolate(out, size, axis)
+        out = resample_axis(out, size, axis=axis)
     return out
-
-
-def _average(image: np.ndarray, size: int, axis: int) -> np.ndarray:
-    """Means over `size` runs of whole pixels along `axis` (runs of n // size or one more)."""
-    n = image.shape[axis]
-    starts = np.arange(size) * n // size
-    counts = np.diff(np.append(starts, n))
-    shape = [1] * image.ndim
-    shape[axis] = size
-    total = np.zeros((*image.shape[:axis], size, *image.shape[axis + 1:]), dtype=np.float32)
-    # One step per pixel of the longest run, adding that pixel of every run at once (a strided
-    # view when the runs are all as long: no copy of a large image).
-    for k in range(int(counts.max())):
-        if n % size == 0:
-            total += image[(slice(None),) * axis + (slice(k, None, n // size),)]
-        else:
-            valid = (counts > k).astype(np.float32).reshape(shape)
-            total += np.take(image, np.minimum(starts + k, n - 1), axis=axis) * valid
-    return total / counts.astype(np.float32).reshape(shape)
-
-
-def _interpolate(image: np.ndarray, size: int, axis: int) -> np.ndarray:
-    n = image.shape[axis]
-    x = (np.arange(size) + 0.5) * n / size - 0.5
-    x0 = np.floor(x).astype(np.int64)
-    weight = (x - x0).astype(np.float32)
-    if axis == 1:
-        low, high = np.mod(x0, n), np.mod(x0 + 1, n)
-    else:
-        low, high = np.clip(x0, 0, n - 1), np.clip(x0 + 1, 0, n - 1)
-    shape = [1] * image.ndim
-    shape[axis] = size
-    weight = weight.reshape(shape)
-    return np.take(image, low, axis=axis) * (1.0 - weight) + np.take(image, high, axis=axis) * weight
 
 
 @dataclass(frozen=True)

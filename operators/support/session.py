@@ -7,8 +7,10 @@ removing it and, on success, places the object where the move puts it. `run_here
 the calling thread (background mode, scripts); `start` hands the work to a `Worker` thread and
 `tick`, called from a modal operator's timer, shows progress and previews and applies the
 result when it arrives. Every step that touches bpy runs on the main thread and is short:
-files are decoded and written by the worker, and the main thread only renames them into place
-and points images at them.
+files are decoded and written by the worker (the earlier results too: the session names their
+files, writing packed ones out first), previews are small whatever the panorama's size, and
+the main thread only renames the results into place and points images at them, which Blender
+loads from the files itself.
 
 Running sessions are kept in `_running` so that file load, unregister and Blender's exit can
 stop and join their threads (the one piece of module state; Blender cannot do it for us).
@@ -36,7 +38,8 @@ from . import warmup, world_layer
 if TYPE_CHECKING:  # the engine is imported only when a run starts
     from ...addon.callbacks import RunCallbacks
     from ...addon.relocation.fixedview import Move
-    from ...addon.run.job import Layer, Preview, RemovalOutcome, RemovalRequest
+    from ...addon.run.job import Layer, RemovalOutcome, RemovalRequest
+    from ...addon.run.preview import Preview
     from ...addon.scene import SceneData
 
 PREVIEW_IMAGE = "DimRed Preview"

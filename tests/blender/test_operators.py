@@ -123,6 +123,23 @@ def test_the_first_preview_shows_before_the_panorama_is_read(room, tmp_path, ext
     assert session.ok, session.message
 
 
+def test_opening_a_file_with_a_marked_object_prepares_its_panorama(room, tmp_path, extension, monkeypatch):
+    from addon.run import small_copy
+    from diminished_reality.operators.support import warmup
+
+    marked = warmup.running(str(room))
+    assert marked is None or marked.join(10.0)
+    cache = str(tmp_path / "cache")
+    monkeypatch.setattr(warmup, "folder", lambda: cache)
+    bpy.ops.wm.save_mainfile()  # with the box marked
+    assert small_copy.cached(str(room), cache) is None
+    bpy.ops.wm.open_mainfile(filepath=str(tmp_path / "room.blend"))
+    deadline = time.perf_counter() + 10.0
+    while small_copy.cached(str(room), cache) is None and time.perf_counter() < deadline:
+        time.sleep(0.01)
+    assert small_copy.cached(str(room), cache) is not None
+
+
 def test_cancel_midway_changes_nothing(room, tmp_path, extension):
     from diminished_reality.operators.support import world_layer
 

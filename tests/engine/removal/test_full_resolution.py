@@ -27,7 +27,8 @@ def _high_pass(y: np.ndarray) -> np.ndarray:
 
 
 def test_the_working_resolution_is_reported_and_used(runs):
-    assert "working_resolution" not in runs["direct"].report
+    assert runs["direct"].report["working_resolution"] == [W, H]
+    assert "refined_pixels" not in runs["direct"].report
     report = runs["working"].report
     assert report["working_resolution"] == [W // 2, H // 2]
     assert report["image_size"] == [W, H]

@@ -24,6 +24,7 @@ def test_downsample_is_the_area_mean_and_keeps_the_total(monkeypatch):
     assert abs(downsample(image, 48, 24).mean() - image.mean()) < 1e-6
     monkeypatch.setattr(working, "_BAND_BYTES", 128 * 3 * 8 * 5)  # bands of 5 rows
     assert np.allclose(downsample(image, 48, 24), downsample(image.astype(np.float64), 48, 24))
+    assert np.allclose(downsample(image, 32, 16), blocks, atol=1e-6)
 
 
 def test_downsample_reads_negative_radiance_as_black():

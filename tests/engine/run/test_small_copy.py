@@ -18,17 +18,15 @@ def test_the_preview_is_at_most_the_preview_width_and_keeps_the_aspect():
 
 
 @pytest.mark.parametrize("shape", [(8, 16), (10, 7), (11, 23)])
-def test_shrinking_averages_whole_pixels(shape):
+def test_shrinking_averages_the_area_each_pixel_covers(shape):
     rng = np.random.default_rng(1)
     image = rng.random((40, 80, 3), dtype=np.float32)
     small = small_copy.resample(image, *shape)
     assert small.shape == (*shape, 3) and small.dtype == np.float32
-    rows = np.arange(shape[0] + 1) * 40 // shape[0]
-    cols = np.arange(shape[1] + 1) * 80 // shape[1]
-    for i in (0, shape[0] - 1):
-        for j in (0, shape[1] - 1):
-            expected = image[rows[i]:rows[i + 1], cols[j]:cols[j + 1]].mean(axis=(0, 1))
-            np.testing.assert_allclose(small[i, j], expected, rtol=1e-5)
+    # Each pixel repeated shape times makes every output pixel a whole block of the copy.
+    fine = np.repeat(np.repeat(image.astype(np.float64), shape[0], axis=0), shape[1], axis=1)
+    expected = fine.reshape(shape[0], 40, shape[1], 80, 3).mean(axis=(1, 3))
+    np.testing.assert_allclose(small, expected, rtol=1e-5)
     np.testing.assert_allclose(small_copy.resample(np.full((40, 80, 3), 2.5, np.float32), *shape), 2.5)
 
 
