@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 _ITERATIONS = 12  # Lloyd steps: the assignment settles within a few on smooth meshes
+_SAMPLE = 8192  # triangles at most that the centres are fitted to
 
 
 @dataclass
@@ -52,14 +53,18 @@ def cluster_triangles(centroids: np.ndarray, normals: np.ndarray, areas: np.ndar
 
 def _kmeans(centroids: np.ndarray, normals: np.ndarray, areas: np.ndarray, count: int, size: float) -> np.ndarray:
     """(T,) labels 0..C-1 (C <= count, no empty cluster) of area-weighted k-means on positions
-    in units of `size` and normals."""
+    in units of `size` and normals. The centres settle on an even sample of at most _SAMPLE
+    triangles (a detailed mesh's neighbours say nothing more about where they go); every
+    triangle then takes its nearest."""
     features = np.concatenate([centroids / max(size, 1e-12), normals], axis=1)
     count = min(count, len(features))
-    centres = _farthest_points(features, count)
+    sample = slice(None, None, -(-len(features) // _SAMPLE))
+    some, weights = features[sample], areas[sample]
+    centres = _farthest_points(some, count)
     for _ in range(_ITERATIONS):
-        label = _nearest(features, centres)
-        weight = np.bincount(label, areas, minlength=count)
-        sums = np.stack([np.bincount(label, areas * column, minlength=count) for column in features.T], axis=1)
+        label = _nearest(some, centres)
+        weight = np.bincount(label, weights, minlength=count)
+        sums = np.stack([np.bincount(label, weights * column, minlength=count) for column in some.T], axis=1)
         # A centre that lost all its triangles stays where it was.
         centres = np.where(weight[:, None] > 0.0, sums / np.maximum(weight, 1e-300)[:, None], centres)
     return np.unique(_nearest(features, centres), return_inverse=True)[1]

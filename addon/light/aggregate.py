@@ -69,39 +69,61 @@ def hierarchy(triangles: np.ndarray, normals: np.ndarray, owner: np.ndarray, cou
         per_sender = -(-np.diff(first) // size)
         row_of.append(np.concatenate([[0], np.cumsum(per_sender)])[owner] + rank // size)
     frame = principal_frame(triangles)
-    framed = in_frame(triangles, frame)
+    members = _Members.of(triangles, normals, in_frame(triangles, frame))
     levels, children, sender = [], [], []
     for level, rows in enumerate(row_of):
         starts = np.searchsorted(rows, np.arange(rows[-1] + 2))
-        levels.append(_aggregates(triangles, framed, normals, starts))
+        levels.append(members.aggregates(starts))
         sender.append(owner[starts[:-1]])
         below = row_of[level + 1] if level + 1 < len(row_of) else np.arange(len(owner))
         children.append(np.append(below[starts[:-1]], below[-1] + 1))
     return Hierarchy(triangles, normals, frame, tuple(levels), tuple(children), tuple(sender), owner)
 
 
-def _aggregates(triangles: np.ndarray, framed: np.ndarray, normals: np.ndarray, starts: np.ndarray) -> Aggregates:
-    """The aggregates of the contiguous runs of triangles starting at starts[:-1] (`framed`:
-    the triangles in the hierarchy's frame, for the boxes)."""
-    first = starts[:-1]
-    cross = np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0])
-    area = 0.5 * np.linalg.norm(cross, axis=1)
-    total = np.add.reduceat(area, first)
-    centre = np.add.reduceat(area[:, None] * triangles.mean(axis=1), first) / np.maximum(total, 1e-300)[:, None]
-    run = np.repeat(np.arange(len(first)), np.diff(starts))
-    reach = np.linalg.norm(triangles - centre[run, None, :], axis=2).max(axis=1)
-    lo, hi = np.minimum.reduceat(framed.min(axis=1), first), np.maximum.reduceat(framed.max(axis=1), first)
-    vector = np.add.reduceat(area[:, None] * normals, first)
-    length = np.linalg.norm(vector, axis=1)
-    has_axis = length > 1e-12 * total
-    axis = np.where(has_axis[:, None], vector / np.maximum(length, 1e-300)[:, None], 0.0)
-    # A run whose normals cancel has no axis: the spread of 2 keeps it from ever counting as a point patch.
-    spread = np.where(has_axis, np.maximum.reduceat(np.linalg.norm(normals - axis[run], axis=1), first), 2.0)
-    along = np.einsum("tkc,tc->tk", triangles, axis[run])
-    offsets = np.stack([np.minimum.reduceat(along.min(axis=1), first), np.maximum.reduceat(along.max(axis=1), first)],
-                       axis=1)
-    return Aggregates(centre, np.maximum.reduceat(reach, first), 0.5 * (lo + hi), 0.5 * (hi - lo), vector, axis,
-                      spread, offsets)
+@dataclass(frozen=True)
+class _Members:
+    """What the aggregates of runs of member triangles are made of, computed once."""
+
+    triangles: np.ndarray  # (T, 3, 3)
+    normals: np.ndarray  # (T, 3)
+    area: np.ndarray  # (T,)
+    moment: np.ndarray  # (T, 3) area times centroid
+    vector: np.ndarray  # (T, 3) area times normal
+    lo: np.ndarray  # (T, 3) bounding box in the hierarchy's frame
+    hi: np.ndarray
+
+    @classmethod
+    def of(cls, triangles: np.ndarray, normals: np.ndarray, framed: np.ndarray) -> _Members:
+        area = 0.5 * np.linalg.norm(np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0]),
+                                    axis=1)
+        lo = np.minimum(np.minimum(framed[:, 0], framed[:, 1]), framed[:, 2])
+        hi = np.maximum(np.maximum(framed[:, 0], framed[:, 1]), framed[:, 2])
+        return cls(triangles, normals, area, area[:, None] * triangles.mean(axis=1), area[:, None] * normals, lo, hi)
+
+    def aggregates(self, starts: np.ndarray) -> Aggregates:
+        """The aggregates of the contiguous runs of members starting at starts[:-1]."""
+        first = starts[:-1]
+        run = np.repeat(np.arange(len(first)), np.diff(starts))
+        total = np.add.reduceat(self.area, first)
+        centre = np.add.reduceat(self.moment, first) / np.maximum(total, 1e-300)[:, None]
+        vector = np.add.reduceat(self.vector, first)
+        length = np.sqrt(np.einsum("ij,ij->i", vector, vector))
+        has_axis = length > 1e-12 * total
+        axis = np.where(has_axis[:, None], vector / np.maximum(length, 1e-300)[:, None], 0.0)
+        reach2 = np.zeros(len(run))
+        along = np.zeros((len(run), 3))
+        for k in range(3):
+            gap = self.triangles[:, k] - centre[run]
+            reach2 = np.maximum(reach2, np.einsum("ij,ij->i", gap, gap))
+            along[:, k] = np.einsum("ij,ij->i", self.triangles[:, k], axis[run])
+        turn = self.normals - axis[run]
+        # A run whose normals cancel has no axis: the spread of 2 keeps it from ever counting as a point patch.
+        spread = np.where(has_axis, np.sqrt(np.maximum.reduceat(np.einsum("ij,ij->i", turn, turn), first)), 2.0)
+        offsets = np.stack([np.minimum.reduceat(along.min(axis=1), first), np.maximum.reduceat(along.max(axis=1), first)],
+                           axis=1)
+        lo, hi = np.minimum.reduceat(self.lo, first), np.maximum.reduceat(self.hi, first)
+        return Aggregates(centre, np.sqrt(np.maximum.reduceat(reach2, first)), 0.5 * (lo + hi), 0.5 * (hi - lo),
+                          vector, axis, spread, offsets)
 
 
 def _morton(points: np.ndarray) -> np.ndarray:

@@ -176,6 +176,7 @@ class RemovalSession:
         With `move`, the run relocates the marked object instead of removing it, from
         `photographed` (its world matrix where the panorama shows it; by default
         `photographed_matrix`)."""
+        from ...addon import memory
         from ...addon.blender import reader
         from ...addon.relocation.fixedview import check_move
         from ...addon.run.job import RemovalRequest
@@ -204,6 +205,8 @@ class RemovalSession:
             folder = scratch
         try:
             reader.check_object(scene, target)
+            # Refused before any work when the panorama cannot fit (the size from its header).
+            memory.check_fits(*reader.panorama_size(scene), quality=settings.quality)
             names = settings.surface_names()
             for name in names:
                 reader.check_object(scene, name, purpose="used as a target surface")

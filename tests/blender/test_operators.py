@@ -57,6 +57,18 @@ def test_refused_removal_changes_nothing(room, tmp_path):
     assert len(bpy.context.scene.world.node_tree.nodes) == 3
 
 
+def test_a_panorama_too_big_for_the_free_memory_is_refused_before_any_work(room, tmp_path, extension, monkeypatch):
+    memory = importlib.import_module(f"{extension.__name__}.addon.memory")
+    monkeypatch.setattr(memory, "available_bytes", lambda: 50_000_000)
+
+    with pytest.raises(RuntimeError, match=r"needs about .* GB of memory .* but only 0.1 GB is available"):
+        bpy.ops.dimred.remove()
+
+    assert not (tmp_path / "dimred").exists()
+    assert bpy.context.scene.dimred.last_report == ""
+    assert len(bpy.context.scene.world.node_tree.nodes) == 3
+
+
 # -- the removal as the UI runs it: a worker thread polled by the modal operator's timer ---------
 
 def _session(extension):
