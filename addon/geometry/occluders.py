@@ -20,22 +20,52 @@ _END_GAP = 30.0  # segment ends stop this many tolerances short of the surfaces 
 
 @dataclass(frozen=True)
 class _Object:
-    frame: np.ndarray  # (3, 3) rows: the axes of the frame its boxes are taken in
-    lo: np.ndarray  # (1, 3, 1) its bounding box in the frame, grown by the tolerance
+    """One object's tests: its frame (None: the axes as they are), its bounding box there,
+    grown by the tolerance ((1, 3, 1) each), the boxes certainly inside it ((1, 3, K) each, K
+    = 0 unless it is closed) and its hierarchy."""
+
+    frame: np.ndarray | None
+    lo: np.ndarray
     hi: np.ndarray
-    inner: np.ndarray  # (1, 3, K) boxes certainly inside it (K = 0 unless it is closed)
+    inner_lo: np.ndarray
     inner_hi: np.ndarray
     tree: bvh.Hierarchy
 
-
-def _object(triangles: np.ndarray, eps: float) -> _Object:
-    frame = solid.principal_frame(triangles)
-    framed = solid.in_frame(triangles, frame)
-    points = framed.reshape(-1, 3)
-    inner = solid.inner_boxes(framed, eps) if solid.closed(triangles, eps) else np.zeros((0, 2, 3))
-    return _Object(frame=frame, lo=(points.min(axis=0) - eps)[None, :, None],
-                   hi=(points.max(axis=0) + eps)[None, :, None], inner=inner[:, 0].T[None],
+    @classmethod
+    def of(cls, triangles: np.ndarray, eps: float) -> _Object:
+        frame = solid.principal_frame(triangles)
+        framed = solid.in_frame(triangles, frame)
+        points = framed.reshape(-1, 3)
+        inner = solid.inner_boxes(framed, eps) if solid.closed(triangles, eps) else np.zeros((0, 2, 3))
+        return cls(frame=None if (frame == np.eye(3)).all() else frame, lo=(points.min(axis=0) - eps)[None, :, None],
+                   hi=(points.max(axis=0) + eps)[None, :, None], inner_lo=inner[:, 0].T[None],
                    inner_hi=inner[:, 1].T[None], tree=bvh.build(triangles, framed, eps))
+
+    def blocked(self, p0: np.ndarray, d: np.ndarray, inv: np.ndarray, tmin: np.ndarray, tmax: np.ndarray
+                ) -> np.ndarray:
+        """(N,) whether segments p0 + t d, tmin < t < tmax (inv = `bvh.inverse(d)`) that meet
+        the object's box in the scene's axes cross it."""
+        out = np.zeros(len(p0), dtype=bool)
+        todo = np.arange(len(p0))
+        q0, e = p0, d
+        if self.frame is not None:
+            q0, e = solid.in_frame(p0, self.frame), solid.in_frame(d, self.frame)
+            inv = bvh.inverse(e)
+            near = bvh.boxes_crossed(q0, inv, tmin, tmax, self.lo, self.hi)[:, 0]
+            todo, q0, e, inv = todo[near], q0[near], e[near], inv[near]
+        t0, t1 = tmin[todo], tmax[todo]
+        if self.inner_lo.shape[2]:
+            # A crossing of the surface lies between a point outside the box and one inside it.
+            outside = self._outside(q0 + t0[:, None] * e) | self._outside(q0 + t1[:, None] * e)
+            sure = outside & bvh.boxes_crossed(q0, inv, t0, t1, self.inner_lo, self.inner_hi).any(axis=1)
+            out[todo[sure]] = True
+            todo, q0, inv, t0, t1 = todo[~sure], q0[~sure], inv[~sure], t0[~sure], t1[~sure]
+        out[todo] = bvh.crossed(self.tree, p0[todo], d[todo], q0, inv, t0, t1)
+        return out
+
+    def _outside(self, points: np.ndarray) -> np.ndarray:
+        """(N,) whether points in the object's frame lie outside its grown bounding box."""
+        return ((points < self.lo[:, :, 0]) | (points > self.hi[:, :, 0])).any(axis=1)
 
 
 class Occluders:
@@ -47,7 +77,12 @@ class Occluders:
 
     def __init__(self, triangles: np.ndarray, tri_object: np.ndarray, eps: float) -> None:
         self.eps = eps
-        self.objects = [_object(triangles[tri_object == k], eps) for k in np.unique(tri_object)]
+        self.objects = [_Object.of(triangles[tri_object == k], eps) for k in np.unique(tri_object)]
+        # Every object's bounding box in the scene's axes, by component (1, 3, K): one test of
+        # all of them tells which objects a segment may meet.
+        corners = [triangles[tri_object == k].reshape(-1, 3) for k in np.unique(tri_object)]
+        self.lo = np.stack([c.min(axis=0) - eps for c in corners], axis=1)[None]
+        self.hi = np.stack([c.max(axis=0) + eps for c in corners], axis=1)[None]
 
     def blocked(self, p0: np.ndarray, p1: np.ndarray) -> np.ndarray:
         """(N,) whether each open segment p0[i] -> p1[i] hits any triangle."""
@@ -60,27 +95,14 @@ class Occluders:
 
     def _blocked_chunk(self, p0: np.ndarray, p1: np.ndarray) -> np.ndarray:
         d = p1 - p0
-        length = np.linalg.norm(d, axis=1)
+        length = np.sqrt(np.einsum("ij,ij->i", d, d))
         tmin = np.minimum(_END_GAP * self.eps / np.maximum(length, 1e-300), 0.5)
         tmax = 1.0 - tmin
+        inv = bvh.inverse(d)
+        near = bvh.boxes_crossed(p0, inv, tmin, tmax, self.lo, self.hi)
         out = np.zeros(len(p0), dtype=bool)
-        for obj in self.objects:
-            todo = np.flatnonzero(~out)
-            q0, e = solid.in_frame(p0[todo], obj.frame), solid.in_frame(d[todo], obj.frame)
-            inv = bvh.inverse(e)
-            near = bvh.boxes_crossed(q0, inv, tmin[todo], tmax[todo], obj.lo, obj.hi)[:, 0]
-            todo, q0, e, inv = todo[near], q0[near], e[near], inv[near]
-            t0, t1 = tmin[todo], tmax[todo]
-            if obj.inner.shape[2]:
-                # A crossing of the surface lies between a point outside the box and one inside it.
-                outside = _outside(q0 + t0[:, None] * e, obj) | _outside(q0 + t1[:, None] * e, obj)
-                sure = outside & bvh.boxes_crossed(q0, inv, t0, t1, obj.inner, obj.inner_hi).any(axis=1)
-                out[todo[sure]] = True
-                todo, q0, e, inv, t0, t1 = todo[~sure], q0[~sure], e[~sure], inv[~sure], t0[~sure], t1[~sure]
-            out[todo] = bvh.crossed(obj.tree, p0[todo], d[todo], q0, inv, t0, t1)
+        for k, obj in enumerate(self.objects):
+            todo = np.flatnonzero(near[:, k] & ~out)
+            if len(todo):
+                out[todo] = obj.blocked(p0[todo], d[todo], inv[todo], tmin[todo], tmax[todo])
         return out
-
-
-def _outside(points: np.ndarray, obj: _Object) -> np.ndarray:
-    """(N,) whether points in the object's frame lie outside its grown bounding box."""
-    return ((points < obj.lo[:, :, 0]) | (points > obj.hi[:, :, 0])).any(axis=1)

@@ -38,17 +38,19 @@ def downsample(radiance: np.ndarray, width: int, height: int) -> np.ndarray:
     return out
 
 
-def upsample(image: np.ndarray, height: int, width: int) -> np.ndarray:
+def upsample(image: np.ndarray, height: int, width: int, *, add_to: np.ndarray | None = None) -> np.ndarray:
     """A working-resolution (h, w, C) image or (h, w) mask at (height, width): images
-    interpolated (float32, in bands of rows), masks by the nearest pixel."""
+    interpolated (float32, in bands of rows; with `add_to`, added into that array instead of
+    a new one), masks by the nearest pixel."""
     h, w = image.shape[:2]
     if image.dtype == bool:
         rows = np.clip(np.round((np.arange(height) + 0.5) * (h / height) - 0.5).astype(np.int64), 0, h - 1)
         cols = np.mod(np.round((np.arange(width) + 0.5) * (w / width) - 0.5).astype(np.int64), w)
         return image[rows][:, cols]
     wide = resample_axis(image.astype(np.float32), width, axis=1)
-    out = np.empty((height, width, *image.shape[2:]), dtype=np.float32)
+    out = np.zeros((height, width, *image.shape[2:]), dtype=np.float32) if add_to is None else add_to
     band = max(1, _BAND_BYTES // (wide[0].nbytes * 4))
     for start in range(0, height, band):
-        out[start:start + band] = interpolate(wide, height, axis=0, samples=np.arange(start, min(start + band, height)))
+        rows = np.arange(start, min(start + band, height))
+        out[start:start + band] += interpolate(wide, height, axis=0, samples=rows)
     return out

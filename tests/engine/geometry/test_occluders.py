@@ -101,10 +101,10 @@ def test_only_a_closed_surface_has_an_inside_and_it_is_inside():
     tris = _fine_box(6, 3)
     assert solid.closed(tris, EPS) and not solid.closed(tris[:-2], EPS)
     occ = Occluders(tris, np.zeros(len(tris), int), EPS)
-    inner = np.concatenate([occ.objects[0].inner, occ.objects[0].inner_hi])[0].T  # (K, 3) corners lo, hi
-    assert occ.objects[0].inner.shape[2] >= 1
+    inner = np.concatenate([occ.objects[0].inner_lo, occ.objects[0].inner_hi], axis=2)[0].T  # (2K, 3): lo, hi
+    assert occ.objects[0].inner_lo.shape[2] >= 1
     open_box = Occluders(tris[:-2], np.zeros(len(tris) - 2, int), EPS)
-    assert open_box.objects[0].inner.shape[2] == 0
+    assert open_box.objects[0].inner_lo.shape[2] == 0
     # The inside boxes' corners lie inside the box, in its own frame (half sizes 0.4, 0.3, 0.25).
     frame = occ.objects[0].frame
     local = solid.in_frame(solid.in_frame(inner, frame.T) - [0.1, 0.2, -0.1], _rotation(3).T)

@@ -181,7 +181,7 @@ def test_the_number_of_insertion_passes_is_a_parameter(tiny):
         relocate_object(tiny, "Box", Move(-90.0, 1.0), quality="draft", insertion_passes=0)
 
 
-def test_above_the_working_resolution_the_move_is_solved_on_the_working_copy(tiny):
+def test_above_the_working_resolution_the_move_is_solved_on_the_working_copy_and_the_removal_at_full_size(tiny):
     small = relocate_object(tiny, "Box", Move(-90.0, 1.0), quality="draft")
     big_scene = replace(tiny, hdri=np.repeat(np.repeat(tiny.hdri, 2, axis=0), 2, axis=1))
     big = relocate_object(big_scene, "Box", Move(-90.0, 1.0), quality="draft", working_width=128)
@@ -191,3 +191,8 @@ def test_above_the_working_resolution_the_move_is_solved_on_the_working_copy(tin
     pooled = big.difference.reshape(64, 2, 128, 2, 3).mean(axis=(1, 3))
     assert np.abs(pooled - small.difference).mean() < 0.2 * np.abs(small.difference).mean()
     assert np.array_equal(big.hidden_mask[::2, ::2], small.hidden_mask)
+    # The old place is filled at full resolution: the removal's own mask and fill are there.
+    removal = remove_object(big_scene, "Box", quality="draft", working_width=128)
+    old = removal.hidden_mask
+    assert big.hidden_mask[old].all()
+    assert np.abs(big.difference[old] - removal.difference[old]).mean() < 0.2 * np.abs(removal.difference[old]).mean()
