@@ -9,7 +9,8 @@ of the synthesis, the CPU seconds of the process (steadier than the wall clock o
 machine) and its peak resident memory during the removal (Linux only; Blender and the loaded
 scene included). The panorama resolution is swept on the 0.5 m box (256x128 and 1024x512).
 It writes `out/tradeoff/tradeoff.csv` and `tradeoff.md` (a row per setting, means over the
-scenes, the Pareto front of error against total seconds marked) and prints the Markdown;
+scenes, the Pareto front of error against total seconds marked; `tradeoff_scenes.csv` has a row
+per scene and setting) and prints the Markdown;
 `benchmarks/plot_tradeoff.py` draws the plot from the CSV.
 
 `--settings` picks the sweep's settings: labels of SETTINGS or `PRESET[+NAME=VALUE...]`
@@ -160,6 +161,14 @@ def markdown(rows: list[dict]) -> str:
     return "\n".join(lines)
 
 
+def _write_csv(path: Path, rows: list[dict]) -> None:
+    with open(path, "w", newline="") as handle:
+        writer = csv.DictWriter(handle, FIELDS)
+        writer.writeheader()
+        for row in rows:
+            writer.writerow({k: (f"{v:.4f}" if isinstance(v, float) else v) for k, v in row.items()})
+
+
 def main() -> None:
     ap = arguments(__doc__)
     ap.add_argument("--out", default="out/tradeoff")
@@ -180,16 +189,13 @@ def main() -> None:
         name, _, samples = item.partition(":")
         wide += _measure(name, args.width, int(samples or args.samples),
                          [setting(t) for t in args.wide_settings.split(",")])
-    for row in wide:
+    for row in rows + wide:
         row["ratio_over_floor"] = row["lighting_ratio"] / row["noise_floor"]
         row["pareto"] = False
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    with open(out / "tradeoff.csv", "w", newline="") as handle:
-        writer = csv.DictWriter(handle, FIELDS)
-        writer.writeheader()
-        for row in table + wide:
-            writer.writerow({k: (f"{v:.4f}" if isinstance(v, float) else v) for k, v in row.items()})
+    _write_csv(out / "tradeoff.csv", table + wide)
+    _write_csv(out / "tradeoff_scenes.csv", rows + wide)
     text = (f"Means over {args.scenes or 'no scenes'} at 256x128 (64 spp), then {args.wide or 'nothing'} at "
             f"{args.width}x{args.width // 2} (SCENE:spp); "
             f"{time.perf_counter() - started:.0f} s in all.\n\n" + markdown(table + wide) + "\n")

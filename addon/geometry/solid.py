@@ -1,10 +1,11 @@
-"""The shape of one occluding object, for fast exact segment tests: the frame its faces align
-with, and boxes certainly inside it when its surface is closed.
+"""The shape of one object, for fast tests against it: the frame its faces align with, and
+boxes certainly inside it when its surface is closed.
 
 In a frame aligned with a piece of furniture its bounding box is tight and the boxes around
 its flat faces are thin, so a segment that ends on a face or passes beside the object meets
-few of them. A segment that enters a region certainly inside a closed surface from a point
-outside its bounding box crosses that surface: it is blocked with no triangle tested.
+few of them, and a receiver beside a face is told apart from the face's plane. A segment that
+enters a region certainly inside a closed surface from a point outside its bounding box
+crosses that surface: it is blocked with no triangle tested.
 """
 from __future__ import annotations
 
@@ -14,6 +15,7 @@ from .raycast import crossings
 
 _GRID = 16  # cells per axis of the grid the inside is found on
 _INNER_BOXES = 8  # the largest boxes of inside cells kept
+_CELL_PAIRS = 1 << 20  # (triangle, cell) pairs tested at once
 _DIRECTION_BIN = 0.05  # normals this close (per component) count as one direction
 _SAMPLE = 4096  # triangles at most that choose the frame
 # Rays of no special direction: one along a mesh's edge or through its vertex could count a
@@ -101,35 +103,35 @@ def inner_boxes(triangles: np.ndarray, margin: float) -> np.ndarray:
     size = np.maximum(hi - lo, 1e-300) / _GRID
     free = ~_touched(triangles, lo, size, margin)
     region = _regions(free)
-    inside = np.zeros(free.shape, dtype=bool)
-    for label in np.unique(region[free]):
-        cell = np.argwhere(region == label)[0]
-        origin = np.broadcast_to(lo + (cell + 0.5) * size, _PARITY_RAYS.shape)
-        odd = crossings(origin, _PARITY_RAYS, triangles) % 2 == 1
-        if odd.all():
-            inside |= region == label
+    labels = np.unique(region[free])  # each the flat index of the region's first cell
+    cells = np.stack(np.unravel_index(labels, free.shape), axis=1)
+    origins = np.repeat(lo + (cells + 0.5) * size, len(_PARITY_RAYS), axis=0)
+    odd = crossings(origins, np.tile(_PARITY_RAYS, (len(labels), 1)), triangles) % 2 == 1
+    inside = np.isin(region, labels[odd.reshape(len(labels), -1).all(axis=1)])
     boxes = _merged(inside)[:_INNER_BOXES]
     return np.stack([lo + boxes[:, 0] * size, lo + boxes[:, 1] * size], axis=1)
 
 
 def _touched(triangles: np.ndarray, lo: np.ndarray, size: np.ndarray, margin: float) -> np.ndarray:
     """(G, G, G) the cells that a triangle may come within `margin` of: its grown bounding box
-    meets the cell and its plane passes near enough."""
+    meets the cell and its plane passes near enough. The (triangle, cell) pairs are taken a
+    batch of triangles at a time (a long sliver spans many cells)."""
     first = np.clip(np.floor((triangles.min(axis=1) - margin - lo) / size), 0, _GRID - 1).astype(np.int64)
     last = np.clip(np.floor((triangles.max(axis=1) + margin - lo) / size), 0, _GRID - 1).astype(np.int64)
     span = last - first + 1
     count = span.prod(axis=1)
-    tri = np.repeat(np.arange(len(triangles)), count)
-    rank = np.arange(len(tri)) - np.repeat(np.cumsum(count) - count, count)
-    cell = first[tri] + np.stack([rank // (span[tri, 1] * span[tri, 2]), rank // span[tri, 2] % span[tri, 1],
-                                  rank % span[tri, 2]], axis=1)
-    normal = np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0])[tri]
-    centre = lo + (cell + 0.5) * size
-    height = np.abs(np.einsum("ij,ij->i", normal, centre - triangles[tri, 0]))
+    normal = np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0])
     reach = np.abs(normal) @ (0.5 * size) + margin * np.linalg.norm(normal, axis=1)
-    near = height <= reach * (1.0 + 1e-9)
     out = np.zeros((_GRID,) * 3, dtype=bool)
-    out[tuple(cell[near].T)] = True
+    batch = np.cumsum(count) // _CELL_PAIRS
+    for b in np.unique(batch):
+        t = np.flatnonzero(batch == b)
+        tri = np.repeat(t, count[t])
+        rank = np.arange(len(tri)) - np.repeat(np.cumsum(count[t]) - count[t], count[t])
+        cell = first[tri] + np.stack([rank // (span[tri, 1] * span[tri, 2]), rank // span[tri, 2] % span[tri, 1],
+                                      rank % span[tri, 2]], axis=1)
+        height = np.abs(np.einsum("ij,ij->i", normal[tri], lo + (cell + 0.5) * size - triangles[tri, 0]))
+        out[tuple(cell[height <= reach[tri] * (1.0 + 1e-9)].T)] = True
     return out
 
 

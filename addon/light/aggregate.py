@@ -4,11 +4,12 @@ a cost that follows how near the receivers are, not how many triangles there are
 A sender's member triangles are grouped by neighbourhood, groups of BRANCH, BRANCH^2, ...
 members, each made of BRANCH smaller ones. Seen from beyond FAR times its radius, wholly above
 the receiver's horizon and with every member facing the receiver, a sender or a group acts as
-a point patch: F = cos_r (V . w) / (pi d^2), V its vector
-area (the members' areas times their normals) and w the unit direction from it to the
-receiver; its relative error is about (radius / d)^2, near 1% on average at FAR = 6. Wholly
-below the horizon or facing away it sends nothing, exactly. Otherwise it is taken by its smaller
-groups, and the smallest member by member with the exact contour formula (`formfactor`).
+a point patch: F = cos_r (V . w) / (pi d^2), V its vector area (the members' areas times their
+normals) and w the unit direction from it to the receiver; its relative error is about
+(radius / d)^2, some 0.1% on average at FAR = 6 summed over a whole object. Wholly below the
+horizon or with every member facing away it sends nothing, exactly. Otherwise it is taken by
+its smaller groups, and the smallest member by member with the exact contour formula
+(`formfactor`), so a receiver beside the object gets its exact form factor.
 """
 from __future__ import annotations
 
@@ -119,8 +120,8 @@ class _Members:
         turn = self.normals - axis[run]
         # A run whose normals cancel has no axis: the spread of 2 keeps it from ever counting as a point patch.
         spread = np.where(has_axis, np.sqrt(np.maximum.reduceat(np.einsum("ij,ij->i", turn, turn), first)), 2.0)
-        offsets = np.stack([np.minimum.reduceat(along.min(axis=1), first), np.maximum.reduceat(along.max(axis=1), first)],
-                           axis=1)
+        offsets = np.stack([np.minimum.reduceat(along.min(axis=1), first),
+                            np.maximum.reduceat(along.max(axis=1), first)], axis=1)
         lo, hi = np.minimum.reduceat(self.lo, first), np.maximum.reduceat(self.hi, first)
         return Aggregates(centre, np.sqrt(np.maximum.reduceat(reach2, first)), 0.5 * (lo + hi), 0.5 * (hi - lo),
                           vector, axis, spread, offsets)
@@ -159,9 +160,9 @@ def form_factors(points: np.ndarray, normals: np.ndarray, h: Hierarchy) -> np.nd
 def _point_patches(x: np.ndarray, n: np.ndarray, xf: np.ndarray, nf: np.ndarray, agg: Aggregates, k: np.ndarray
                    ) -> tuple[np.ndarray, np.ndarray]:
     """Pairs of receivers x (P, 3) with unit normals n (P, 3) (xf, nf: in the hierarchy's
-    frame) and aggregates k (P,): the form
-    factor (P,) where the aggregate is a point patch for the receiver (0 where it sends
-    nothing) and (P,) where it is neither, so it must be taken by its parts.
+    frame) and aggregates k (P,): the form factor (P,) where the aggregate is a point patch
+    for the receiver (0 where it sends nothing) and (P,) where it is neither, so it must be
+    taken by its parts.
 
     The members' heights over the receiver's tangent plane are bounded by the aggregate's
     ball and box, the receiver's heights in front of the members' planes by their offsets

@@ -31,16 +31,23 @@ def ratio_change(radiance: np.ndarray, e: np.ndarray, de: np.ndarray, apply: np.
     pixel implies a reflectance above RHO_MAX, E is taken as large as that bound allows (a
     lamp's glare or a model error would otherwise turn into a huge relative change); a change
     that would make the radiance negative is clamped to black."""
-    dark = (e @ LUMA) <= 1e-6 * max(e_ref, 1e-30)
-    rep.guard("irradiance_near_zero_pixels", np.count_nonzero(apply & dark & ((np.abs(de) @ LUMA) > 0)))
+    # LUMA in the arrays' own precision: a float64 vector would turn a float32 band's
+    # product into a ten times slower mixed one.
+    dark = (e @ LUMA.astype(e.dtype)) <= 1e-6 * max(e_ref, 1e-30)
+    near_zero = np.flatnonzero(apply & dark)
+    rep.guard("irradiance_near_zero_pixels", np.count_nonzero((np.abs(de[near_zero]) @ LUMA) > 0))
     apply = apply & ~dark
-    e = np.maximum(e, 1e-30)
+    # In place where it can be: a band of a 16K panorama is millions of pixels.
+    e_eff = np.maximum(e, 1e-30)
     # The E that implies a reflectance of RHO_MAX: pi L / E > RHO_MAX wherever E is below it.
     floor = radiance * (np.pi / RHO_MAX)
-    over = floor > e
+    over = floor > e_eff
     rep.guard("reflectance_clamped_pixels", np.count_nonzero(apply & (over[:, 0] | over[:, 1] | over[:, 2])))
-    d = radiance * de / np.maximum(e, floor)
-    d[~apply] = 0.0
-    negative = d < -radiance
+    np.maximum(e_eff, floor, out=e_eff)
+    d = radiance * de
+    d /= e_eff
+    d[np.flatnonzero(~apply)] = 0.0
+    black = np.negative(radiance, out=floor)
+    negative = d < black
     rep.guard("negative_radiance_clamped", np.count_nonzero(negative[:, 0] | negative[:, 1] | negative[:, 2]))
-    return np.maximum(d, -radiance)
+    return np.maximum(d, black, out=d)

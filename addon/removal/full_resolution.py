@@ -28,7 +28,7 @@ from .object_window import ObjectWindow, object_window
 from .solution import Solution
 from .working_maps import Cells, WorkingMaps, cells, neighbours, pixel_directions_at, surfaces_seen, working_maps
 
-_BAND_PIXELS = 1 << 21  # full-resolution pixels per band
+_BAND_PIXELS = 1 << 19  # full-resolution pixels per band (arrays of a few MB: reused, not mapped anew)
 _SHARP = 0.1  # neighbours whose dE / E differ by more than this leave the pixel to be refined
 
 

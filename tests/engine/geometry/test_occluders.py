@@ -61,27 +61,34 @@ MESHES = {
     "fine rotated box": lambda: _fine_box(12, 2),
     "sphere": lambda: _sphere(40),
     "open box (no lid)": lambda: _fine_box(6, 3)[:-2 * 36],
-    "two boxes, one object": lambda: np.concatenate([_fine_box(4, 4), _fine_box(3, 5) + [1.5, 0.0, 0.0]]),
+    "two boxes, one object": lambda: np.concatenate([_fine_box(4, 4), _fine_box(3, 5) + np.array([1.5, 0.0, 0.0])]),
 }
 
 
 def _segments(tris: np.ndarray, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
-    """Random segments around the mesh, segments from random points to points on its surface,
-    and segments through points a hair's breadth beside its edges."""
+    """Random segments around the mesh, segments between random points and points on its
+    surface and between two points on it, and segments through points a hair's breadth beside
+    its edges."""
     lo, hi = tris.reshape(-1, 3).min(axis=0), tris.reshape(-1, 3).max(axis=0)
     pad = 0.5 * (hi - lo)
     around = [rng.uniform(lo - pad, hi + pad, (3000, 3)) for _ in range(2)]
     pick = rng.integers(0, len(tris), 2000)
     w = rng.dirichlet([1, 1, 1], 2000)
     on = np.einsum("nk,nkc->nc", w, tris[pick])
+    # A segment within a face's plane has no answer in floating point (its hits on that
+    # plane are rounding), so two points on the surface are joined only across planes.
+    normal = np.cross(tris[pick, 1] - tris[pick, 0], tris[pick, 2] - tris[pick, 0])[:1000]
+    across = on[1000:] - on[:1000]
+    across = np.abs(np.einsum("ij,ij->i", normal, across)) > 1e-6 * np.linalg.norm(normal, axis=1) * np.linalg.norm(
+        across, axis=1)
     start = rng.uniform(lo - pad, hi + pad, (2000, 3))
     edge = rng.integers(0, 3, 1500)
     pick = rng.integers(0, len(tris), 1500)
     a, b = tris[pick, edge], tris[pick, (edge + 1) % 3]
     near_edge = a + rng.uniform(0, 1, (1500, 1)) * (b - a) + rng.normal(size=(1500, 3)) * 10 * EPS
     direction = rng.normal(size=(1500, 3))
-    p0 = np.concatenate([around[0], start, on, near_edge - direction])
-    p1 = np.concatenate([around[1], on, start, near_edge + direction])
+    p0 = np.concatenate([around[0], start, on, on[:1000][across], near_edge - direction])
+    p1 = np.concatenate([around[1], on, start, on[1000:][across], near_edge + direction])
     return p0, p1
 
 
