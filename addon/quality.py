@@ -20,7 +20,7 @@ class Params:
     """Every user-visible knob of a removal (the method's parameters: docs/design.md, "Parameters")."""
 
     patches: int = 500  # target number of radiosity patches on the room (coarse solution)
-    object_patches: int = 100  # target number of patches on the removed object (at least 1 per triangle)
+    object_patches: int = 100  # target number of patches on the removed object (a detailed one is clustered)
     sender_fraction: float = 0.98  # important senders hold this share of the bright patches' power
     max_senders: int = 32  # ... but at most this many (thesis default: 32)
     sender_samples: int = 4  # k: an important sender is sampled at k*k points for visibility

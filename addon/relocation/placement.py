@@ -10,6 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import DimredError
+from ..geometry import solid
 from ..geometry.occluders import Occluders
 from ..geometry.raycast import crossings, first_hits
 from ..scene import SceneData
@@ -119,7 +120,7 @@ def _collisions(before: np.ndarray, after: np.ndarray, others: np.ndarray, other
         occluders = Occluders(tris, other_ids[other_ids == k], eps)
         # Inside and outside mean something for a closed mesh only (a ceiling with lamp holes
         # is crossed once or not at all, wherever one stands).
-        closed = _closed(tris, eps)
+        closed = solid.closed(tris, max(eps, 1e-12))
         if _collides(after, tris, occluders, closed=closed) and not _collides(before, tris, occluders, closed=closed):
             found.append(int(k))
     return found
@@ -139,10 +140,3 @@ def _collides(obj: np.ndarray, tris: np.ndarray, occluders: Occluders, *, closed
     return bool(inside or occluders.blocked(edge_starts, edge_ends).any())
 
 
-def _closed(triangles: np.ndarray, eps: float) -> bool:
-    """Whether the triangles form closed surfaces: every edge shared by an even number of them."""
-    corners = np.round(triangles.reshape(-1, 3) / max(eps, 1e-12)).astype(np.int64)
-    ids = np.unique(corners, axis=0, return_inverse=True)[1].reshape(-1, 3)
-    edges = np.sort(np.stack([ids, np.roll(ids, -1, axis=1)], axis=-1).reshape(-1, 2), axis=1)
-    _, counts = np.unique(edges, axis=0, return_counts=True)
-    return bool((counts % 2 == 0).all())
