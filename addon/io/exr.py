@@ -86,12 +86,24 @@ def read_exr(path: str | os.PathLike[str]) -> np.ndarray:
 def write_exr(path: str | os.PathLike[str], image: np.ndarray) -> None:
     """Write (H, W, 3) RGB as a float32 PIZ-compressed scanline EXR, top row first, atomically.
 
-    Rows are converted to float32 a band at a time: no full-size copy is made.
+    A float32 image is written as it is, by the library's whole-image interface, which lets
+    go of Python's interpreter lock while it compresses (Blender's interface stays responsive
+    while a worker writes); any other dtype is converted a band at a time (`write_exr_rows`),
+    so no full-size copy is made.
     """
     rgb = np.asarray(image)
     if rgb.ndim != 3 or rgb.shape[2] != 3:
         raise ValueError(f"write_exr expects an (H, W, 3) array, got shape {rgb.shape}")
-    write_exr_rows(path, rgb.shape[0], rgb.shape[1], lambda start, stop: rgb[start:stop])
+    if rgb.dtype != np.float32 or not rgb.flags.c_contiguous:
+        write_exr_rows(path, rgb.shape[0], rgb.shape[1], lambda start, stop: rgb[start:stop])
+        return
+    header = {"compression": OpenEXR.PIZ_COMPRESSION, "type": OpenEXR.scanlineimage}
+
+    def write(temp_path: str) -> None:
+        _library_call(path, "write", lambda: OpenEXR.File(header, {"RGB": rgb}).write(temp_path), _FILE_ERRORS)
+        _library_call(path, "write", lambda: _check_complete(path, temp_path, rgb.shape[0]), _SCANLINE_ERRORS)
+
+    _write_atomically(os.fspath(path), write)
 
 
 def write_exr_rows(path: str | os.PathLike[str], height: int, width: int,

@@ -211,15 +211,21 @@ def test_file_without_colour_channels(tmp_path):
     assert "no R, G, B channels (channels: Y)" in _single_line_error(tmp_path / "y.exr")
 
 
-def _failing_write_keeps(tmp_path, monkeypatch, output_file, expected: str) -> None:
-    """With `output_file` standing in for OpenEXR.OutputFile, a write fails with `expected` in
-    its message, and the file written before is left as it was, with no temporary beside it."""
+def _failing_write_keeps(tmp_path, monkeypatch, output_file, expected: str, *, interface: str = "OutputFile"
+                         ) -> None:
+    """With `output_file` standing in for OpenEXR.OutputFile (the banded writer) or
+    OpenEXR.File (the whole-image one), a write fails with `expected` in its message, and the
+    file written before is left as it was, with no temporary beside it."""
     path = tmp_path / "keep.exr"
     old = _hdr_image()
     exr.write_exr(path, old)
-    monkeypatch.setattr(exr.OpenEXR, "OutputFile", output_file)
+    monkeypatch.setattr(exr.OpenEXR, interface, output_file)
+    new = np.zeros((2, 2, 3), np.float32)
     with pytest.raises(DimredError, match=expected):
-        exr.write_exr(path, np.zeros((2, 2, 3), np.float32))
+        if interface == "File":
+            exr.write_exr(path, new)
+        else:
+            exr.write_exr_rows(path, 2, 2, lambda start, stop: new[start:stop])
     monkeypatch.undo()
     np.testing.assert_array_equal(exr.read_exr(path), old)
     assert os.listdir(tmp_path) == ["keep.exr"]
@@ -241,6 +247,34 @@ def test_failed_write_keeps_the_old_file_and_leaves_no_temporary(tmp_path, monke
             pass
 
     _failing_write_keeps(tmp_path, monkeypatch, HalfWritingFile, "No space left on device")
+
+
+def test_a_whole_image_write_that_fails_or_is_cut_short_keeps_the_old_file(tmp_path, monkeypatch):
+    real = exr.OpenEXR.File
+
+    class FailingFile:
+        """Writes part of a file, then fails like a full disk."""
+
+        def __init__(self, header, channels):
+            pass
+
+        def write(self, target):
+            with open(target, "wb") as handle:
+                handle.write(b"v/1\x01partial")
+            raise RuntimeError("No space left on device")
+
+    class TruncatingFile:
+        """The library's own writer, but the last bytes never reach the disk."""
+
+        def __init__(self, header, channels):
+            self.file = real(header, channels)
+
+        def write(self, target):
+            self.file.write(target)
+            os.truncate(target, os.path.getsize(target) - 1)
+
+    _failing_write_keeps(tmp_path, monkeypatch, FailingFile, "No space left on device", interface="File")
+    _failing_write_keeps(tmp_path, monkeypatch, TruncatingFile, "incomplete", interface="File")
 
 
 def test_a_file_cut_short_as_it_is_closed_is_not_kept(tmp_path, monkeypatch):
