@@ -23,9 +23,10 @@ from scenes import spec as S
 from scenes.images import read_exr
 from scenes.render import REPO, render_pair
 
-# A checker floor with two ceiling lamps; a noise-textured floor under a small lamp 10^3 times
-# brighter than the other, right above the cylinder: the sharpest contact shadow of the registry.
-SCENES = ["basic_box", "bright_lamp"]
+# A checker floor with two ceiling lamps. The same check passes on bright_lamp (a small lamp 10^3
+# times brighter, right above a cylinder: the sharpest contact shadow of the registry), whose
+# 2048x1024 pair takes about 5 minutes to render here: too long for every run of the suite.
+SCENES = ["basic_box"]
 # 8 samples keep a 2048x1024 render near a minute on two free cores.
 SAMPLES = 8
 TOLERANCE = 0.03
