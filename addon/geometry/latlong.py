@@ -54,26 +54,6 @@ def pixel_solid_angles(width: int, height: int) -> np.ndarray:
     return (band * 2.0 * np.pi / width)[:, None]
 
 
-def sample_bilinear(image: np.ndarray, u: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """Bilinear lookup at (u, v): wraps around the u seam, clamps at the poles."""
-    h, w = image.shape[:2]
-    x = np.asarray(u, dtype=np.float64) * w - 0.5
-    y = (1.0 - np.asarray(v, dtype=np.float64)) * h - 0.5
-    x0 = np.floor(x)
-    y0 = np.floor(y)
-    fx = (x - x0)[..., None]
-    fy = (y - y0)[..., None]
-    x0 = x0.astype(np.int64)
-    y0 = y0.astype(np.int64)
-    xa = np.mod(x0, w)
-    xb = np.mod(x0 + 1, w)
-    ya = np.clip(y0, 0, h - 1)
-    yb = np.clip(y0 + 1, 0, h - 1)
-    top = image[ya, xa] * (1.0 - fx) + image[ya, xb] * fx
-    bottom = image[yb, xa] * (1.0 - fx) + image[yb, xb] * fx
-    return top * (1.0 - fy) + bottom * fy
-
-
 def uv_to_pixel(u: np.ndarray, v: np.ndarray, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
     """Integer (row, column) of the texel containing (u, v)."""
     col = np.mod(np.floor(np.asarray(u) * width).astype(np.int64), width)

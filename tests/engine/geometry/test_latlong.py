@@ -58,17 +58,6 @@ def test_pixel_solid_angles_sum_to_the_sphere(size):
     assert omega.sum() * width == pytest.approx(4.0 * math.pi, rel=1e-12)
 
 
-def test_sample_bilinear_wraps_the_seam_and_clamps_the_poles():
-    image = np.zeros((4, 8, 3))
-    image[:, 0] = 1.0  # first column
-    image[:, -1] = 3.0  # last column
-    image[0, 3] = 5.0  # top row, away from the seam
-    at_seam = latlong.sample_bilinear(image, np.array([0.0, 1.0]), np.array([0.375, 0.375]))
-    np.testing.assert_allclose(at_seam, 2.0)  # halfway between the first and the last column
-    pole = latlong.sample_bilinear(image, np.array(3.5 / 8), np.array(1.0))
-    np.testing.assert_allclose(pole, 5.0)  # clamped to the top row, not wrapped to the bottom
-
-
 def test_uv_to_pixel_wraps_the_seam_and_clamps_the_poles():
     """u wraps (u < 0 is the last column, u = 1 the first); v is clamped (v = 1 is the top row,
     v = 0 the bottom row, not a row past the image)."""

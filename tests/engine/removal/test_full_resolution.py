@@ -2,6 +2,8 @@
 light is upsampled and refined, the hidden region traced and filled at the panorama's size."""
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 import tiny_room
@@ -68,3 +70,21 @@ def test_bands_change_nothing(runs, monkeypatch):
     monkeypatch.setattr(full_resolution, "_BAND_PIXELS", W * 7)  # bands of 7 rows, the last one short
     banded = remove_object(runs["scene"], "Box", working_width=W // 2)
     assert np.array_equal(banded.difference, runs["working"].difference)
+
+
+def test_an_object_across_the_seam(runs):
+    # The room turned so the box straddles u = 0: the window wraps round the seam.
+    scene = runs["scene"]
+    cols = np.flatnonzero(runs["direct"].hidden_mask.any(axis=0))
+    shift = W - (cols.min() + cols.max()) // 2
+    angle = -2 * np.pi * shift / W
+    turn = np.array([[np.cos(angle), -np.sin(angle), 0.0], [np.sin(angle), np.cos(angle), 0.0], [0.0, 0.0, 1.0]])
+    seam = replace(scene, rotation=turn @ scene.rotation, hdri=np.roll(scene.hdri, shift, axis=1))
+    direct = remove_object(seam, "Box", working_width=W)
+    up = remove_object(seam, "Box", working_width=W // 2)
+    assert direct.hidden_mask[:, 0].any() and direct.hidden_mask[:, -1].any()
+    assert np.array_equal(up.hidden_mask, direct.hidden_mask)
+    keep = ~direct.hidden_mask
+    change = np.abs(direct.difference[keep] @ LUMA).mean()
+    assert np.abs((up.difference[keep] - direct.difference[keep]) @ LUMA).mean() < 0.11 * change
+    assert up.report["hidden_region_filled"]
