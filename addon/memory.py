@@ -14,14 +14,15 @@ from .errors import DimredError
 
 # Bytes per full-resolution pixel, measured on removals of 8192 x 4096 and 16384 x 8192
 # panoramas (peak resident memory against the pixel count: 2.3 and 4.7 GB at balanced, Blender
-# included, so about 24 bytes a pixel on top of a fixed part; 8 more are kept as a margin).
+# included, so about 24 bytes a pixel on top of a fixed part; 8 more are kept as a margin; final:
+# 2.8 GB at 8192 x 4096).
 INPUT_BYTES_PER_PIXEL = 12  # the panorama, float32 RGB
 DIFFERENCE_BYTES_PER_PIXEL = 12  # the difference image, float32 RGB
 BAND_BYTES_PER_PIXEL = 8  # the hidden mask, per-pixel flags and the bands in flight
 #: Bytes the working-resolution solve, the object's window and Blender itself hold whatever the
 #: panorama's size, per quality preset (measured as above: the intercept of peak memory against
 #: pixel count; final solves at twice the working width).
-SOLVE_BYTES = {"draft": 1_300_000_000, "balanced": 1_400_000_000, "final": 2_200_000_000}
+SOLVE_BYTES = {"draft": 1_300_000_000, "balanced": 1_400_000_000, "final": 2_000_000_000}
 
 _GB = 1e9
 
