@@ -20,6 +20,7 @@ import sys
 import tempfile
 import time
 from collections.abc import Callable, Iterator, Sequence
+from concurrent.futures import ThreadPoolExecutor
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -252,14 +253,13 @@ def write_outputs(out: str, result: RemovalResult, report: dict) -> None:
     Everything is written into a hidden staging folder first (inside `out` when it exists,
     else in its deepest existing parent, so the final renames stay on one file system) and
     moved in only when complete: a failure leaves `out` and earlier results in it as they were.
-    The images are written a band of rows at a time (the edited panorama never exists whole)
-    and refused at the first band with a non-finite value.
+    The edited panorama is written a band of rows at a time (it never exists whole) and
+    refused at the first band with a non-finite value; the difference is checked first.
     """
-    from ..io.exr import write_exr_rows, write_png
+    from ..io.exr import write_exr, write_exr_rows, write_png
+    from ..radiance import non_finite_pixels
 
     height, width = result.difference.shape[:2]
-    images = {"difference.exr": lambda start, stop: result.difference[start:stop],
-              "edited.exr": result.edited_rows}
     mask = result.hidden_mask if report.get("hidden_region_filled") is False else None
     try:
         payload = json.dumps(report, indent=2, allow_nan=False)
@@ -270,8 +270,15 @@ def write_outputs(out: str, result: RemovalResult, report: dict) -> None:
     except OSError as error:
         raise DimredError(f"cannot write into {out}: {error.strerror or error}") from None
     try:
-        for name, rows in images.items():
-            write_exr_rows(os.path.join(staging, name), height, width, _finite(name, rows))
+        if non_finite_pixels(result.difference):
+            raise DimredError("the removal produced non-finite values in difference.exr; nothing was written")
+        # The whole-image writer lets go of the interpreter lock while it compresses, so the
+        # difference is written on a second core beside the edited panorama's bands.
+        with ThreadPoolExecutor(max_workers=1) as pool:
+            difference = pool.submit(write_exr, os.path.join(staging, "difference.exr"), result.difference)
+            edited = _finite("edited.exr", result.edited_rows)
+            write_exr_rows(os.path.join(staging, "edited.exr"), height, width, edited)
+            difference.result()
         if mask is not None:
             write_png(os.path.join(staging, "hidden_mask.png"), np.where(mask, 255, 0).astype(np.uint8))
         with open(os.path.join(staging, "report.json"), "w", encoding="utf-8") as handle:

@@ -59,8 +59,11 @@ def full_resolution(solution: Solution, hdri: np.ndarray, rep: Report, callbacks
     height, width = hdri.shape[:2]
     full = (height, width)
     maps = working_maps(solution)
-    window = object_window(solution.geo, solution.target, solution.traced.hidden_map, _exemplar_extent(solution),
-                           full, maps)
+    with rep.stage("window"):
+        window = object_window(solution.geo, solution.target, solution.traced.hidden_map,
+                               _exemplar_extent(solution), full, maps)
+    if window is not None:
+        rep.info["object_window"] = list(window.hidden.shape[::-1])  # width, height
     apply = ~solution.traced.hidden_h & ~solution.room.pixels.emitter_h
     e_ref = reference_irradiance(solution.e_h, apply)
     difference = np.zeros((height, width, 3), dtype=np.float32)

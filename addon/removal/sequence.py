@@ -131,8 +131,8 @@ def remove(scene: SceneData, object_name: str, *, planes: list[str] | tuple[str,
     height, width = scene.hdri.shape[:2]
     size = working_size(width, height, max_width=params.working_width)
     full_size = size != (width, height)
-    # Above the working width the compose stage gives way to downsample, upsample and refine.
-    rep = Report(callbacks.progress, stages=STAGES + 2 * full_size)
+    # Above the working width the compose stage gives way to downsample, window, upsample and refine.
+    rep = Report(callbacks.progress, stages=STAGES + 3 * full_size)
     rep.info["working_resolution"] = list(size)
     if not full_size:
         return finish(solve(scene, object_name, planes, params, rep, callbacks), rep, callbacks)
