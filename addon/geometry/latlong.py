@@ -47,6 +47,11 @@ def pixel_directions(width: int, height: int, rotation: np.ndarray | None = None
     return uv_to_direction(u, v, rotation)
 
 
+def pixel_directions_at(rows: np.ndarray, cols: np.ndarray, width: int, height: int) -> np.ndarray:
+    """(..., 3) unit directions through the centres of pixels (rows, cols) of a W x H panorama."""
+    return uv_to_direction((np.asarray(cols) + 0.5) / width, 1.0 - (np.asarray(rows) + 0.5) / height)
+
+
 def pixel_solid_angles(width: int, height: int) -> np.ndarray:
     """(H, 1) solid angle of one pixel in each row (exact for the row's latitude band)."""
     edges = np.pi * np.arange(height + 1) / height  # polar angle of row boundaries, top first

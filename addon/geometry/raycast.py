@@ -181,9 +181,8 @@ def window_directions(width: int, height: int, window: tuple[int, int, int, int]
     """(rows, cols, 3) unit directions through the pixel centres of a window (first row, rows,
     first column, columns) of a W x H panorama; the columns wrap around the seam."""
     row0, rows, col0, cols = window
-    u = (np.mod(col0 + np.arange(cols), width) + 0.5) / width
-    v = 1.0 - (row0 + np.arange(rows) + 0.5) / height
-    return latlong.uv_to_direction(*np.broadcast_arrays(u[None, :], v[:, None]))
+    grid = np.broadcast_arrays((row0 + np.arange(rows))[:, None], np.mod(col0 + np.arange(cols), width)[None, :])
+    return latlong.pixel_directions_at(*grid, width, height)
 
 
 def _ray_distances(origins: np.ndarray, directions: np.ndarray, triangles: np.ndarray):

@@ -26,7 +26,7 @@ from .fill import Revealed, fill_hidden, hidden_planes, measured_reflectance, su
 from .local import Receiving, light_at
 from .object_window import ObjectWindow, object_window
 from .solution import Solution
-from .working_maps import Cells, WorkingMaps, cells, neighbours, pixel_directions_at, surfaces_seen, working_maps
+from .working_maps import Cells, WorkingMaps, cells, neighbours, surfaces_seen, working_maps
 
 _BAND_PIXELS = 1 << 19  # full-resolution pixels per band (arrays of a few MB: reused, not mapped anew)
 _SHARP = 0.1  # neighbours whose dE / E differ by more than this leave the pixel to be refined
@@ -153,7 +153,8 @@ def _upsample(solution: Solution, maps: WorkingMaps, window: ObjectWindow | None
 
         e, de = bilinear(e_map).reshape(-1, 3), bilinear(de_map).reshape(-1, 3)
         plain = grid.plain[pair][:, col].ravel()
-        sharp = plain & (grid.spread[pair][:, col].ravel() > _SHARP)
+        cell_spread = grid.spread[pair][:, col].ravel()
+        sharp = plain & (cell_spread > _SHARP)
         cell_key = maps.key[(top[pair] * maps.width)[:, None] + col[None, :]].ravel()
         pixels = _BandPixels.of(rows, width, window, solution.target.surface_key)
         # The pixels the cells cannot serve as they are: those of a mixed cell, and in the
@@ -162,7 +163,7 @@ def _upsample(solution: Solution, maps: WorkingMaps, window: ObjectWindow | None
         slow = np.flatnonzero(~fast & ~pixels.hidden)
         served = fast.copy()
         refine = np.zeros(len(plain), dtype=bool)
-        spread = np.where(sharp, grid.spread[pair][:, col].ravel(), 0.0)
+        spread = np.where(sharp, cell_spread, 0.0)
         if len(slow):
             got = _mixed(solution, maps, pixels, rows, width, slow, height)
             e[slow], de[slow] = got.e, got.de
@@ -236,7 +237,7 @@ class _BandPixels:
             return
         r, c = rows[0] + index // width, index % width
         near = neighbours(r, c, (height, width), maps)
-        found = surfaces_seen(pixel_directions_at(r, c, (height, width)), near.nearest, solution.geo, maps)
+        found = surfaces_seen(latlong.pixel_directions_at(r, c, width, height), near.nearest, solution.geo, maps)
         self.tri[index], self.bary[index], self.distance[index] = found.tri, found.bary, found.distance
         self.own[index] = np.where(found.tri >= 0, self.keys[np.maximum(found.tri, 0)], -1)
         self.known[index] = True
@@ -300,7 +301,7 @@ def _refined_light(solution: Solution, pixel: np.ndarray, tri: np.ndarray, bary:
     height, width = hdri.shape[:2]
     rows, cols = np.divmod(pixel, width)
     room, geo, target = solution.room, solution.geo, solution.target
-    points = pixel_directions_at(rows, cols, (height, width)) * distance[:, None]
+    points = latlong.pixel_directions_at(rows, cols, width, height) * distance[:, None]
     patch, corners, weights = room.patches.lattice.locate(tri, bary)
     relit = ~room.emitter[patch]
     if target.planes:
@@ -345,7 +346,7 @@ def _revealed(solution: Solution, window: ObjectWindow, window_e: np.ndarray, hd
     rho = rho.reshape(radiance.shape).astype(np.float32, copy=False)
     tri = window.tri[revealed].astype(np.int64)
     distance = window.distance[revealed].astype(np.float64)
-    directions = pixel_directions_at(rows[revealed], cols[revealed], (frame.height, frame.width))
+    directions = latlong.pixel_directions_at(rows[revealed], cols[revealed], frame.width, frame.height)
     solid = latlong.pixel_solid_angles(frame.width, frame.height)[rows[revealed], 0]
     footprint = surface_footprint(solid, directions, solution.geo.normals[tri], distance)
     return Revealed(tri=tri, bary=window.bary[revealed].astype(np.float64), points=directions * distance[:, None],

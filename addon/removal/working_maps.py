@@ -6,7 +6,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..geometry import latlong
 from ..geometry.candidates import CandidateHits, hits_among
 from ..geometry.mesh import Geometry
 from ..light.radiosity import LUMA
@@ -101,13 +100,6 @@ def neighbours(rows: np.ndarray, cols: np.ndarray, full: tuple[int, int], maps: 
     ny = np.clip(np.round(y).astype(np.int64), 0, maps.height - 1)
     nx = np.mod(np.round(x).astype(np.int64), maps.width)
     return Neighbours(index, weight, ny * maps.width + nx)
-
-
-def pixel_directions_at(rows: np.ndarray, cols: np.ndarray, full: tuple[int, int]) -> np.ndarray:
-    """(N, 3) unit directions through the centres of pixels (rows, cols) of a (height, width)
-    panorama."""
-    height, width = full
-    return latlong.uv_to_direction((cols + 0.5) / width, 1.0 - (rows + 0.5) / height)
 
 
 def surfaces_seen(directions: np.ndarray, nearest: np.ndarray, geo: Geometry, maps: WorkingMaps) -> CandidateHits:
