@@ -21,7 +21,7 @@ from ..callbacks import NO_CALLBACKS, RunCallbacks
 from ..errors import DimredError
 from ..light.radiosity import LUMA
 from ..quality import Params, rough
-from ..removal import RemovalResult, Solution, finish, remove, solve, solve_lighting, traced_scene
+from ..removal import RemovalResult, Solution, finish, finish_full_size, solve, solve_lighting, traced_scene
 from ..removal.sequence import STAGES
 from ..removal.target import object_index
 from ..removal.working import downsample, upsample, working_size
@@ -56,26 +56,37 @@ def relocate(scene: SceneData, object_name: str, move: Move, *, planes: list[str
     height, width = scene.hdri.shape[:2]
     size = working_size(width, height, max_width=params.working_width)
     if size == (width, height):
-        return _relocated(scene, object_name, move, target, planes, params, callbacks)[0]
+        return _relocated(scene, object_name, move, target, planes, params, callbacks).result
     # The moved object's pixels are carried from the working copy, where the move is solved;
     # the removal at its old place runs at full resolution (its fill as sharp as the panorama),
     # and the insertion's change is upsampled onto it.
-    small, inserted = _relocated(replace(scene, hdri=downsample(scene.hdri, *size)), object_name, move, target,
-                                 planes, params, callbacks.scaled(0.0, 0.75, ""))
-    removal = remove(scene, object_name, planes=planes, params=params,
-                     callbacks=callbacks.scaled(0.75, 1.0, "removal at full resolution: "))
-    upsample(inserted, height, width, add_to=removal.difference)
-    report = {**small.report, "working_resolution": list(size),
+    small = _relocated(replace(scene, hdri=downsample(scene.hdri, *size)), object_name, move, target, planes, params,
+                       callbacks.scaled(0.0, 0.75, ""))
+    # The removal's solution on the working copy is the one the relocation already solved.
+    full_callbacks = callbacks.scaled(0.75, 1.0, "removal at full resolution: ")
+    removal = finish_full_size(small.removal, scene.hdri, Report(full_callbacks.progress, stages=4), full_callbacks)
+    upsample(small.inserted, height, width, add_to=removal.difference)
+    report = {**small.result.report, "working_resolution": list(size),
               "full_resolution_removal_seconds": removal.report["seconds"]}
     return RemovalResult(difference=removal.difference,
-                         hidden_mask=removal.hidden_mask | upsample(small.hidden_mask, height, width), report=report,
-                         hdri=scene.hdri)
+                         hidden_mask=removal.hidden_mask | upsample(small.result.hidden_mask, height, width),
+                         report=report, hdri=scene.hdri)
+
+
+@dataclass(frozen=True)
+class _Relocated:
+    """A relocation at the panorama's own size, the insertion's share of its change (H, W, 3):
+    what the panorama without the object becomes with it at its new place, and the removal's
+    solution it started from."""
+
+    result: RemovalResult
+    inserted: np.ndarray
+    removal: Solution
 
 
 def _relocated(scene: SceneData, object_name: str, move: Move, target: int, planes: list[str] | tuple[str, ...],
-               params: Params, callbacks: RunCallbacks) -> tuple[RemovalResult, np.ndarray]:
-    """The relocation at the panorama's own size, and the insertion's share of its change
-    (H, W, 3): what the panorama without the object becomes with it at its new place."""
+               params: Params, callbacks: RunCallbacks) -> _Relocated:
+    """The relocation at the panorama's own size."""
     passes = params.insertion_passes
     if passes < 1:
         raise DimredError(f"insertion_passes must be at least 1, got {passes}")
@@ -123,7 +134,7 @@ def _relocated(scene: SceneData, object_name: str, move: Move, target: int, plan
     report = _relocation_report(removed.report, steps, insertion.as_dict(), move, placement, carried, passes)
     result = RemovalResult(difference=difference, hidden_mask=hidden.reshape(photo.shape[:2]), report=report,
                            hdri=photo)
-    return result, (current - without).reshape(photo.shape).astype(np.float32)
+    return _Relocated(result, (current - without).reshape(photo.shape).astype(np.float32), old)
 
 
 def _inserted(new: Solution, without: np.ndarray, carried: Carried, callbacks: RunCallbacks

@@ -26,7 +26,8 @@ Glossary:
   patch a piece of a proxy triangle on the coarse lattice (or a cluster of a detailed
         object's triangles); sender: a patch as a source of light for the others
 """
-from .sequence import RemovalResult, finish, remove, solve, solve_lighting, traced_scene
+from .sequence import RemovalResult, finish, finish_full_size, remove, solve, solve_lighting, traced_scene
 from .solution import Solution
 
-__all__ = ["RemovalResult", "Solution", "finish", "remove", "solve", "solve_lighting", "traced_scene"]
+__all__ = ["RemovalResult", "Solution", "finish", "finish_full_size", "remove", "solve", "solve_lighting",
+           "traced_scene"]

@@ -141,10 +141,15 @@ def remove(scene: SceneData, object_name: str, *, planes: list[str] | tuple[str,
     solution = solve(working, object_name, planes, params, rep, callbacks)
     if callbacks.preview is not None:
         callbacks.show(_difference_image(solution.traced, compose(solution, Report())))
-    full = full_resolution(solution, scene.hdri, rep, callbacks)
+    return finish_full_size(solution, scene.hdri, rep, callbacks)
+
+
+def finish_full_size(solution: Solution, hdri: np.ndarray, rep: Report, callbacks: RunCallbacks = NO_CALLBACKS
+                     ) -> RemovalResult:
+    """The edited full-resolution panorama `hdri` from a removal solved on its working copy."""
+    full = full_resolution(solution, hdri, rep, callbacks)
     rep.info["hidden_region_filled"] = full.filled
-    return RemovalResult(difference=full.difference, hidden_mask=full.hidden_mask, report=rep.as_dict(),
-                         hdri=scene.hdri)
+    return RemovalResult(difference=full.difference, hidden_mask=full.hidden_mask, report=rep.as_dict(), hdri=hdri)
 
 
 def _difference_image(traced: Traced, d_h: np.ndarray) -> np.ndarray:
