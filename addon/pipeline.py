@@ -10,6 +10,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from .alignment.fit import Alignment, align_object
 from .callbacks import NO_CALLBACKS, RunCallbacks
 from .errors import DimredError
 from .quality import DEFAULT_QUALITY, Params, params_for
@@ -17,7 +18,12 @@ from .radiance import clamped_rows, negative_pixels, non_finite_pixels
 from .relocation.fixedview import Move
 from .relocation.insertion import relocate
 from .removal import RemovalResult, remove
+from .removal.sequence import photographed
+from .removal.target import object_index
+from .report import Report
 from .scene import SceneData
+from .segmentation.seen import SeenObject
+from .segmentation.user_mask import UserMask
 
 
 def validate(scene: SceneData) -> None:
@@ -38,8 +44,8 @@ def validate(scene: SceneData) -> None:
         raise DimredError("the probe centre is not a finite point")
 
 
-def _run(scene: SceneData, quality: str, overrides: dict, compute: Callable[[SceneData, Params], RemovalResult]
-         ) -> RemovalResult:
+def _run(scene: SceneData, quality: str, overrides: dict, compute: Callable[[SceneData, Params], RemovalResult],
+         *, align: str | None = None, fit_height: bool = False) -> RemovalResult:
     validate(scene)
     params = params_for(quality, **overrides)
     # Negative radiance is not light: the engine reads it as black (`radiance.clamped_rows`),
@@ -49,6 +55,10 @@ def _run(scene: SceneData, quality: str, overrides: dict, compute: Callable[[Sce
     original = scene.hdri
     if negative and scene.hdri.shape[1] <= params.working_width:
         scene = replace(scene, hdri=clamped_rows(scene.hdri, 0, scene.hdri.shape[0]))
+    alignment = None
+    if align is not None:
+        alignment = align_object(scene, align, params=params, fit_height=fit_height)
+        scene = alignment.moved(scene, object_index(scene, align))
     result = compute(scene, params)
     report = dict(result.report)
     report["guards"] = {**report["guards"], "negative_input_pixels_clamped": negative}
@@ -56,6 +66,11 @@ def _run(scene: SceneData, quality: str, overrides: dict, compute: Callable[[Sce
     report["parameters"] = {k: getattr(params, k) for k in params.__dataclass_fields__}
     report["image_size"] = [int(scene.hdri.shape[1]), int(scene.hdri.shape[0])]
     report["notes"] = [*report.get("notes", []), *scene.notes]
+    if alignment is not None:
+        report["alignment"] = alignment.summary()
+        report["seconds"] = {**report["seconds"], "alignment": round(alignment.seconds, 4)}
+        if not alignment.applied:
+            report["warnings"] = [*report["warnings"], alignment.message]
     return replace(result, hdri=original, report=report)
 
 
@@ -66,13 +81,20 @@ def remove_object(
     planes: Sequence[str] = (),
     quality: str = DEFAULT_QUALITY,
     callbacks: RunCallbacks = NO_CALLBACKS,
+    mask: UserMask | None = None,
+    align: bool = False,
+    fit_height: bool = False,
     **overrides: object,
 ) -> RemovalResult:
     """Remove `object_name` from the scene's panorama; `overrides` change single parameters of
     the quality preset. `callbacks.preview(difference)` gets coarse difference images before
-    the result (see `removal.remove`)."""
+    the result (see `removal.remove`). The region filled is where the photograph shows the
+    object, `mask` added or taken away; with `align` the proxy's pose is first fitted to the
+    photograph (`alignment.fit.align_object`; `report["alignment"]` says how)."""
     return _run(scene, quality, overrides,
-                lambda s, params: remove(s, object_name, planes=list(planes), params=params, callbacks=callbacks))
+                lambda s, params: remove(s, object_name, planes=list(planes), params=params, callbacks=callbacks,
+                                         mask=mask),
+                align=object_name if align else None, fit_height=fit_height)
 
 
 def relocate_object(
@@ -83,10 +105,32 @@ def relocate_object(
     planes: Sequence[str] = (),
     quality: str = DEFAULT_QUALITY,
     callbacks: RunCallbacks = NO_CALLBACKS,
+    mask: UserMask | None = None,
+    align: bool = False,
+    fit_height: bool = False,
     **overrides: object,
 ) -> RemovalResult:
     """Move `object_name` under the fixed-view constraint (see `relocation.insertion.relocate`):
-    the same images and report as a removal, with `report["relocation"]` describing the move."""
+    the same images and report as a removal, with `report["relocation"]` describing the move;
+    `mask` and `align` as for `remove_object` (the move starts from the aligned pose)."""
     return _run(scene, quality, overrides,
                 lambda s, params: relocate(s, object_name, move, planes=list(planes), params=params,
-                                           callbacks=callbacks))
+                                           callbacks=callbacks, mask=mask),
+                align=object_name if align else None, fit_height=fit_height)
+
+
+def align_to_photo(scene: SceneData, object_name: str, *, quality: str = DEFAULT_QUALITY, fit_height: bool = False,
+                   **overrides: object) -> Alignment:
+    """Fit `object_name`'s pose on its support to its outline in the panorama (Align to Photo)."""
+    validate(scene)
+    params = params_for(quality, **overrides)
+    if negative_pixels(scene.hdri):
+        scene = replace(scene, hdri=clamped_rows(scene.hdri, 0, scene.hdri.shape[0]))
+    return align_object(scene, object_name, params=params, fit_height=fit_height)
+
+
+def photographed_object(scene: SceneData, object_name: str, *, quality: str = DEFAULT_QUALITY,
+                        mask: UserMask | None = None, **overrides: object) -> SeenObject | None:
+    """The object as the panorama shows it around its proxy (what a removal would fill)."""
+    validate(scene)
+    return photographed(scene, object_name, params_for(quality, **overrides), Report(), mask=mask)

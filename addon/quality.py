@@ -43,6 +43,10 @@ class Params:
     # panorama takes it from there (upsampled, refined where it is sharp, filled at its own size)
     working_width: int = 1024
     refine_pixels: int = 200_000  # full-resolution pixels on sharp shadow edges given their own light, at most
+    # the region to fill is segmented from the photograph in a band around the proxy's silhouette
+    # this wide (a share of the object's angular size): wide enough for a proxy placed by eye a
+    # few centimetres, degrees and percent off; 0 turns the segmentation off (the proxy decides)
+    segmentation_band: float = 0.12
     # relocation: solver passes towards the inserted object's fixed point (2 at least: the first
     # lacks the object's reflected light)
     insertion_passes: int = 2

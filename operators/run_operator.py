@@ -26,6 +26,19 @@ def world_poll(cls: type[bpy.types.Operator], context: bpy.types.Context) -> boo
     return True
 
 
+def target_poll(cls: type[bpy.types.Operator], context: bpy.types.Context) -> bool:
+    """A World, a marked object and no removal running: what a run on the marked object needs."""
+    if not world_poll(cls, context):
+        return False
+    if context.scene.dimred.target is None:
+        cls.poll_message_set("Mark the object to remove first")
+        return False
+    if session.active() is not None:
+        cls.poll_message_set("A removal is already running: wait for it or cancel it")
+        return False
+    return True
+
+
 class RunOperator:
     """What Remove and Relocate share: a run of `session.RemovalSession`, synchronous from
     `execute` and threaded from `invoke` (a modal operator polling it on a timer, Esc cancels).
@@ -37,15 +50,7 @@ class RunOperator:
 
     @classmethod
     def poll(cls, context: bpy.types.Context) -> bool:
-        if not world_poll(cls, context):
-            return False
-        if context.scene.dimred.target is None:
-            cls.poll_message_set("Mark the object to remove first")
-            return False
-        if session.active() is not None:
-            cls.poll_message_set("A removal is already running: wait for it or cancel it")
-            return False
-        return True
+        return target_poll(cls, context)
 
     def plan(self, context: bpy.types.Context) -> tuple[Move | None, Matrix | None]:
         """The move to run (None: remove) and the object's photographed matrix (None: the

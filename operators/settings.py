@@ -31,6 +31,11 @@ def _is_mesh(_settings: bpy.types.PropertyGroup, obj: bpy.types.Object) -> bool:
     return obj.type == 'MESH'
 
 
+def _is_still(_settings: bpy.types.PropertyGroup, image: bpy.types.Image) -> bool:
+    # What the mask reader can read: one picture, not a render result, movie or tile set.
+    return image.source in {'FILE', 'GENERATED'} and image.type == 'IMAGE'
+
+
 def _target_changed(settings: bpy.types.PropertyGroup, _context: bpy.types.Context) -> None:
     # A Remove is likely next: its first preview wants a small copy of the panorama ready.
     if settings.target is not None:
@@ -140,6 +145,29 @@ class DimredSettings(bpy.types.PropertyGroup):
                      "automatically"),
         type=DimredSurface,
     )
+    mask_image: PointerProperty(
+        name="Mask",
+        description=("Painted over the panorama, its size or an integer fraction of it: white adds to the region "
+                     "the removal fills, black takes away, grey or transparent leaves it as the photograph shows it"),
+        type=bpy.types.Image,
+        poll=_is_still,
+    )
+    align_first: BoolProperty(
+        name="Align to Photo First",
+        description=("Align to Photo before removing or relocating: the proxy's pose is fitted to the object's "
+                     "outline in the panorama, and the object keeps the fitted pose when the run succeeds"),
+    )
+    fit_height: BoolProperty(
+        name="Fit Support Height",
+        description=("Align to Photo fits the height of the surface the object stands on instead of its scale: "
+                     "for a proxy whose size is known (from one viewpoint a smaller object and a nearer one look "
+                     "alike)"),
+    )
+    photo_fit: StringProperty(
+        name="Photo Fit",
+        description="How the proxy fitted the photograph at the last run or Align to Photo, as JSON",
+        options={'HIDDEN'},
+    )
     quality: EnumProperty(name="Quality", items=QUALITY_ITEMS, default=DEFAULT_QUALITY)
     output_dir: StringProperty(
         name="Output Folder",
@@ -225,6 +253,12 @@ class DimredSettings(bpy.types.PropertyGroup):
         self.target = obj
         self.marked_name = obj.name
         self.marked_matrix = _flat(obj.matrix_world)
+
+    def correct_marked(self, name: str, correction: Matrix) -> None:
+        """Align to Photo moved object `name` by the world matrix `correction`: where it stood
+        when marked moves with it, so a later hand-made move is measured from the fitted pose."""
+        if self.marked_name == name:
+            self.marked_matrix = _flat(correction @ _matrix(self.marked_matrix))
 
     def marked_placement(self) -> Matrix | None:
         """The target's world matrix when it was marked, if it was marked under its present name."""

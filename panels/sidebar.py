@@ -33,7 +33,13 @@ class DIMRED_PT_main(bpy.types.Panel):
         box = layout.box()
         box.label(text="Object to Remove", icon='OBJECT_DATA')
         box.prop(settings, "target", text="")
-        box.operator("dimred.mark_remove", icon='RESTRICT_SELECT_OFF')
+        row = box.row(align=True)
+        row.operator("dimred.mark_remove", icon='RESTRICT_SELECT_OFF')
+        row.operator("dimred.align", icon='SNAP_ON')
+        box.prop(settings, "align_first")
+        box.prop(settings, "fit_height")
+        box.label(text="Mask", icon='MOD_MASK')
+        box.template_ID(settings, "mask_image", new="dimred.new_mask", open="image.open")
 
         box = layout.box()
         box.label(text="Target Surfaces", icon='MESH_PLANE')
@@ -84,6 +90,9 @@ class DIMRED_PT_main(bpy.types.Panel):
                                  icon='ORIENTATION_GIMBAL')
                 else:
                     column.label(text=entry.object_name, icon='GHOST_ENABLED')
+        box = layout.box()
+        _photo_fit(box, settings.photo_fit)
+        box.operator("dimred.show_diagnostics", icon='IMAGE_DATA')
 
 
 class DIMRED_PT_parameters(bpy.types.Panel):
@@ -141,6 +150,25 @@ class DIMRED_PT_last_run(bpy.types.Panel):
             layout.label(text=line, icon='INFO')
         if isinstance(report.get("relocation"), dict):
             layout.label(text=f"Moved: {session.move_summary(report['relocation'])}", icon='ORIENTATION_GIMBAL')
+
+
+def _photo_fit(layout: bpy.types.UILayout, stored: str) -> None:
+    """A line on how the proxy fitted the photograph (the share of its silhouette and the
+    photographed object's that agree) and one on the alignment's correction."""
+    try:
+        fit = json.loads(stored) if stored else {}
+    except json.JSONDecodeError:
+        return
+    segmentation, alignment = fit.get("segmentation"), fit.get("alignment")
+    if isinstance(segmentation, dict) and "agreement" in segmentation:
+        layout.label(text=f"{fit.get('object', '')}: {100 * segmentation['agreement']:.0f} % of the outline agrees",
+                     icon='SHADING_BBOX')
+    if isinstance(alignment, dict) and alignment.get("applied"):
+        shift = sum(v * v for v in alignment["shift_cm"]) ** 0.5
+        layout.label(text=(f"Aligned: {shift:.1f} cm, {alignment['turn_deg']:+.1f}°, "
+                           f"{alignment['scale_percent']:+.1f} %"), icon='SNAP_ON')
+    elif isinstance(alignment, dict):
+        layout.label(text="Not aligned: the proxy stays where it was", icon='ERROR')
 
 
 def _lines(entries: object) -> list[str]:

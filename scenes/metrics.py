@@ -183,6 +183,19 @@ def hidden_region_scores(input: np.ndarray, edit: np.ndarray, truth: np.ndarray,
     }
 
 
+def ghost_share(edit: np.ndarray, truth: np.ndarray, object_mask: np.ndarray, *, threshold: float = 0.3) -> float:
+    """Share of the object's pixels (the true object's `object_mask`) where the edit is visibly
+    off the truth: blurred |Y_edit - Y_truth| > `threshold` * blurred Y_truth. A proxy off the
+    object can leave a sliver of the object itself where the hidden region missed it: few
+    pixels in the ratios' sums, plainly visible in the picture. Raises ValueError if the mask
+    is empty."""
+    mask = np.asarray(object_mask, dtype=bool)
+    if not mask.any():
+        raise ValueError("the object mask is empty")
+    ye, yt = _blurred_y(edit), _blurred_y(truth)
+    return float((np.abs(ye - yt) > threshold * yt)[mask].mean())
+
+
 def relocation_region(input: np.ndarray, moved: np.ndarray, empty: np.ndarray, old_mask: np.ndarray,
                       new_mask: np.ndarray, margin: int = 2) -> np.ndarray:
     """(H, W) bool: where a relocation must change the panorama. The object at its old place

@@ -451,6 +451,54 @@ def _demo() -> SceneSpec:
     )
 
 
+def _far_dark_box() -> SceneSpec:
+    room = Room(lo=(-2.0, -1.8, 0.0), hi=(4.2, 2.6, 2.8), wall_albedo=(0.72, 0.72, 0.74),
+                floor=Floor("checker", (0.78, 0.77, 0.74), (0.58, 0.58, 0.56), 0.3))
+    # 3 m from the probe, left of the image centre: the box covers ~10 degrees, its shadow lies
+    # on a light floor whose tiles a ghost of the proxy's outline would show.
+    return SceneSpec(
+        name="far_dark_box",
+        room=room,
+        lamps=(Lamp((3.0, 1.9), (0.5, 0.4), 35.0), Lamp((-0.6, -0.8), (0.6, 0.6), 18.0)),
+        objects=(SceneObject("DarkBox", "box", (0.55, 0.45, 0.5), _on_floor(room, 2.6, 1.5),
+                             (0.06, 0.06, 0.07), rotation_z=35.0),),
+        probe=(0.0, 0.0, 1.5),
+        remove="DarkBox",
+    )
+
+
+def _tall_cabinet() -> SceneSpec:
+    room = Room(lo=(-2.4, -2.2, 0.0), hi=(2.6, 2.0, 2.6), wall_albedo=(0.8, 0.78, 0.74),
+                floor=Floor("noise", (0.4, 0.4, 0.42), (0.6, 0.6, 0.62), 0.2))
+    # Right of the image centre, its nearest corner 5 cm from the -Y wall, a bright lamp above
+    # the gap behind it: the cabinet's shadow falls forwards over the floor towards the probe.
+    return SceneSpec(
+        name="tall_cabinet",
+        room=room,
+        lamps=(Lamp((0.7, -2.1), (0.6, 0.14), 70.0), Lamp((-1.0, 1.0), (0.5, 0.5), 15.0)),
+        objects=(SceneObject("Cabinet", "box", (0.4, 0.35, 1.6), _on_floor(room, 0.7, -1.955),
+                             (0.5, 0.42, 0.35), rotation_z=-6.0),),
+        probe=(0.1, 0.2, 1.5),
+        remove="Cabinet",
+    )
+
+
+def _warm_cylinder() -> SceneSpec:
+    room = Room(lo=(-2.6, -1.6, 0.0), hi=(2.4, 2.4, 2.7), wall_albedo=(0.76, 0.7, 0.62),
+                floor=Floor("planks", (0.5, 0.33, 0.2), (0.36, 0.22, 0.12), 0.15))
+    # Elliptic, so a turn shows; near -X, a few degrees from the panorama's seam.
+    return SceneSpec(
+        name="warm_cylinder",
+        room=room,
+        lamps=(Lamp((-1.4, 0.9), (0.5, 0.5), 30.0, (1.0, 0.78, 0.52)),
+               Lamp((1.2, -0.5), (0.7, 0.4), 14.0, (1.0, 0.86, 0.68))),
+        objects=(SceneObject("Cylinder", "cylinder", (0.42, 0.3, 0.55), _on_floor(room, -1.8, 0.45),
+                             (0.3, 0.5, 0.35), rotation_z=30.0),),
+        probe=(0.0, 0.1, 1.45),
+        remove="Cylinder",
+    )
+
+
 SPECS: dict[str, SceneSpec] = {s.name: s for s in (
     _basic_box(),
     _red_box(),
@@ -468,6 +516,9 @@ SPECS: dict[str, SceneSpec] = {s.name: s for s in (
     _zenith(),
     _grazing(),
     _demo(),
+    _far_dark_box(),
+    _tall_cabinet(),
+    _warm_cylinder(),
 )}
 
 

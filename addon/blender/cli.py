@@ -2,7 +2,8 @@
 
     python -m addon.cli remove SCENE.blend --object NAME --out DIR [options]
     python -m addon.cli relocate SCENE.blend --object NAME --yaw DEG --distance-scale S --out DIR [options]
-    blender -b SCENE.blend -c dimred remove|relocate ... (the same arguments)
+    python -m addon.cli align SCENE.blend --object NAME --out DIR [--save COPY.blend] [options]
+    blender -b SCENE.blend -c dimred remove|relocate|align ... (the same arguments)
 
 Both run `run_cli`; inside Blender the .blend is already open, so SCENE.blend is optional.
 Bad input gets one line `dimred: error: ...` on stderr, exit code 2, and nothing on disk.
@@ -32,6 +33,8 @@ from ..quality import DEFAULT_QUALITY, DESCRIPTIONS
 
 if TYPE_CHECKING:
     from ..removal import RemovalResult
+    from ..scene import SceneData
+    from ..segmentation.seen import SeenObject
 
 PROG = "dimred"
 #: Exit status for bad input (the same as argparse's usage errors).
@@ -44,7 +47,11 @@ synthesised from the surface around it. Writes into the output folder:
 
   difference.exr   what to add to the panorama (RGB float32, the panorama's size)
   edited.exr       the panorama plus the difference
-  report.json      seconds per stage, skipped stages, warnings, guards, error estimates
+  report.json      seconds per stage, skipped stages, warnings, guards, error estimates,
+                   the segmentation and (with --align) the alignment
+  diagnostics.png  the proxy's silhouette against the object's outline in the photograph
+                   (cyan: the proxy's outline, yellow: the photograph's; red: object the proxy
+                   misses, blue: proxy over no object)
   hidden_mask.png  only when the region the object hid could not be filled (white = hidden)
 
 Files are written only when the whole run succeeds."""
@@ -64,7 +71,23 @@ ProbeCenter, else the world origin.
 examples:
   python -m addon.cli remove room.blend --object Box --out out/
   blender -b room.blend -c dimred remove --object Box --plane Floor --quality final --out out/
-  python -m addon.cli relocate room.blend --object Box --yaw 40 --distance-scale 1.3 --out out/"""
+  python -m addon.cli remove room.blend --object Box --align --mask cable.png --out out/
+  python -m addon.cli relocate room.blend --object Box --yaw 40 --distance-scale 1.3 --out out/
+  python -m addon.cli align room.blend --object Box --out out/ --save room_aligned.blend"""
+
+_ALIGN_DESCRIPTION = """Align to Photo: fit the pose of a proxy placed by eye to the object's outline in the panorama,
+segmented around the proxy's silhouette: a shift along its support, a turn about the vertical
+and a uniform scale about its bottom centre (with --fit-height: the support's height instead
+of the scale, for a proxy whose size is known). Writes into the output folder:
+
+  report.json      "alignment": the correction (shift_cm, turn_deg, scale_percent), its world
+                   matrix C (the corrected matrix_world is C @ matrix_world), the outline's rms
+                   distance before and after (pixels); "segmentation": what the photograph showed
+  diagnostics.png  the corrected proxy's silhouette against the outline
+
+With --save, a copy of the .blend with the corrected object (the .blend itself is not changed).
+A fit that does not converge to a plausible pose leaves the proxy where it was, says so and
+exits with status 1 (report.json is written, no copy is saved)."""
 
 _RELOCATE_DESCRIPTION = """\
 Move a real object elsewhere in the HDR panorama under the fixed-view constraint: the
@@ -141,16 +164,35 @@ def build_parser(*, blend_already_loaded: bool) -> argparse.ArgumentParser:
     relocate.add_argument("--distance-scale", type=float, default=1.0, metavar="S",
                           help="factor on the object's horizontal distance from that axis (> 0; default 1)")
     relocate.set_defaults(run=_relocate)
+    align = commands.add_parser(
+        "align",
+        help="fit the proxy's pose to the object's outline in the panorama (Align to Photo)",
+        description=_ALIGN_DESCRIPTION,
+        epilog=_EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    _scene_arguments(align, blend_already_loaded, "the mesh object to align", removal=False)
+    align.add_argument("--save", metavar="COPY.blend", help="write a copy of the .blend with the corrected object")
+    align.set_defaults(run=_align)
     return parser
 
 
-def _scene_arguments(parser: argparse.ArgumentParser, blend_already_loaded: bool, object_help: str) -> None:
+def _scene_arguments(parser: argparse.ArgumentParser, blend_already_loaded: bool, object_help: str, *,
+                     removal: bool = True) -> None:
     blend_help = "the scene (.blend) to read"
     if blend_already_loaded:
         parser.add_argument("blend", nargs="?", metavar="SCENE.blend", help=blend_help + " (default: the open file)")
     else:
         parser.add_argument("blend", metavar="SCENE.blend", help=blend_help)
     parser.add_argument("--object", required=True, metavar="NAME", help=object_help)
+    parser.add_argument("--fit-height", action="store_true",
+                        help="align: fit the support's height instead of the object's scale (a proxy of known size)")
+    if removal:
+        parser.add_argument("--align", action="store_true",
+                            help="first fit the proxy's pose to the object's outline in the panorama (Align to Photo)")
+        parser.add_argument("--mask", metavar="FILE",
+                            help="image the panorama's size (or an integer fraction of it): white adds to the region "
+                                 "filled, black takes away, grey or transparent leaves it")
     parser.add_argument(
         "--plane",
         action="append",
@@ -173,7 +215,8 @@ def _scene_arguments(parser: argparse.ArgumentParser, blend_already_loaded: bool
 def _remove(args: argparse.Namespace) -> int:
     from .. import pipeline
 
-    return _run(args, "removed", lambda scene, **options: pipeline.remove_object(scene, args.object, **options))
+    return _run(args, "removed", lambda scene, **options: pipeline.remove_object(
+        scene, args.object, align=args.align, fit_height=args.fit_height, **options))
 
 
 def _relocate(args: argparse.Namespace) -> int:
@@ -183,18 +226,91 @@ def _relocate(args: argparse.Namespace) -> int:
     move = Move(args.yaw, args.distance_scale)
     # Before the scene is read: a request no placement satisfies needs no .blend.
     check_move(move)
-    return _run(args, "moved", lambda scene, **options: pipeline.relocate_object(scene, args.object, move, **options))
+    return _run(args, "moved", lambda scene, **options: pipeline.relocate_object(
+        scene, args.object, move, align=args.align, fit_height=args.fit_height, **options))
+
+
+def _align(args: argparse.Namespace) -> int:
+    import bpy
+    from mathutils import Matrix
+
+    from .. import pipeline
+    from ..io.exr import write_png
+
+    started = time.perf_counter()
+    out = _output_folder(args.out)
+    scene_data = _read(args)
+    save = os.path.abspath(args.save) if args.save else None
+    if save and os.path.abspath(bpy.data.filepath) == save:
+        raise DimredError("--save must name a copy, not the .blend that is open")
+    alignment = pipeline.align_to_photo(scene_data, args.object, quality=args.quality, fit_height=args.fit_height)
+    moved = alignment.moved(scene_data, scene_data.object_index(args.object))
+    seen = pipeline.photographed_object(moved, args.object, quality=args.quality)
+    report = {"alignment": alignment.summary(), "segmentation": seen.summary() if seen else None,
+              "seconds": {"alignment": round(alignment.seconds, 4),
+                          "total": round(time.perf_counter() - started, 4)}}
+    picture = None if seen is None else diagnostics_image(seen)
+    _write_files(out, {"report.json": _json_writer(report)}
+                 | ({} if picture is None else {"diagnostics.png": lambda path: write_png(path, picture)}),
+                 stale=("diagnostics.png",))
+    if not alignment.applied:
+        print(f"{PROG}: {alignment.message}", file=sys.stderr, flush=True)
+        return 1
+    if save:
+        obj = bpy.context.scene.objects[args.object]
+        obj.matrix_world = Matrix(alignment.matrix.tolist()) @ obj.matrix_world
+        try:
+            bpy.ops.wm.save_as_mainfile(filepath=save, copy=True)
+        except RuntimeError as error:
+            raise DimredError(f"cannot save {save}: {str(error).strip()}") from None
+    print(f"{PROG}: {alignment.message}; wrote {out}" + (f" and {save}" if save else ""), flush=True)
+    return 0
 
 
 def _run(args: argparse.Namespace, done: str, compute: Callable[..., object]) -> int:
+    started = time.perf_counter()
+    out = _output_folder(args.out)
+    scene_data = _read(args)
+    mask = None
+    if args.mask:
+        from .mask_reader import read_mask_file
+
+        mask = read_mask_file(args.mask, (scene_data.hdri.shape[1], scene_data.hdri.shape[0]))
+    loaded = time.perf_counter()
+    result = compute(
+        scene_data,
+        planes=list(args.plane),
+        quality=args.quality,
+        mask=mask,
+        callbacks=RunCallbacks(progress=_print_progress if args.verbose else None),
+    )
+    report = dict(result.report)
+    seconds = dict(report.get("seconds", {}))
+    seconds["read_scene"] = round(loaded - started, 4)
+    seconds["total"] = round(time.perf_counter() - started, 4)
+    report["seconds"] = seconds
+    write_outputs(out, result, report)
+    total = time.perf_counter() - started
+    print(f"{PROG}: {done} '{args.object}' in {total:.1f} s; wrote {out}", flush=True)
+    for warning in report.get("warnings", []):
+        print(f"{PROG}: warning: {warning}", file=sys.stderr)
+    return 0
+
+
+def _output_folder(path: str) -> str:
+    out = os.path.abspath(path)
+    if os.path.exists(out) and not os.path.isdir(out):
+        raise DimredError(f"--out {out} is a file, not a folder")
+    return out
+
+
+def _read(args: argparse.Namespace) -> SceneData:
+    """The scene of the command's .blend (opened unless inside Blender), its object checked,
+    refused before its pixels are read when the run cannot fit in memory."""
     import bpy
 
     from . import reader
 
-    started = time.perf_counter()
-    out = os.path.abspath(args.out)
-    if os.path.exists(out) and not os.path.isdir(out):
-        raise DimredError(f"--out {out} is a file, not a folder")
     if args.blend is not None:
         open_blend(args.blend)
     elif not bpy.data.filepath:
@@ -209,27 +325,10 @@ def _run(args: argparse.Namespace, done: str, compute: Callable[..., object]) ->
     width, height = reader.panorama_size(scene)
     memory.check_fits(width, height, quality=args.quality)
     scene_data = reader.read_scene(scene, center=args.center)
-    loaded = time.perf_counter()
     if args.verbose:
         for note in scene_data.notes:
             print(f"{PROG}: note: {note}", file=sys.stderr)
-    result = compute(
-        scene_data,
-        planes=list(args.plane),
-        quality=args.quality,
-        callbacks=RunCallbacks(progress=_print_progress if args.verbose else None),
-    )
-    report = dict(result.report)
-    seconds = dict(report.get("seconds", {}))
-    seconds["read_scene"] = round(loaded - started, 4)
-    seconds["total"] = round(time.perf_counter() - started, 4)
-    report["seconds"] = seconds
-    write_outputs(out, result, report)
-    total = time.perf_counter() - started
-    print(f"{PROG}: {done} '{args.object}' in {total:.1f} s; wrote {out}", flush=True)
-    for warning in report.get("warnings", []):
-        print(f"{PROG}: warning: {warning}", file=sys.stderr)
-    return 0
+    return scene_data
 
 
 def open_blend(path: str) -> None:
@@ -248,28 +347,16 @@ def open_blend(path: str) -> None:
 
 
 def write_outputs(out: str, result: RemovalResult, report: dict) -> None:
-    """Write the result files into `out`, all or nothing.
-
-    Everything is written into a hidden staging folder first (inside `out` when it exists,
-    else in its deepest existing parent, so the final renames stay on one file system) and
-    moved in only when complete: a failure leaves `out` and earlier results in it as they were.
-    The edited panorama is written a band of rows at a time (it never exists whole) and
-    refused at the first band with a non-finite value; the difference is checked first.
-    """
+    """Write the result files into `out`, all or nothing (see `_write_files`). The edited
+    panorama is written a band of rows at a time (it never exists whole) and refused at the
+    first band with a non-finite value; the difference is checked first."""
     from ..io.exr import write_exr, write_exr_rows, write_png
     from ..radiance import non_finite_pixels
 
     height, width = result.difference.shape[:2]
     mask = result.hidden_mask if report.get("hidden_region_filled") is False else None
-    try:
-        payload = json.dumps(report, indent=2, allow_nan=False)
-    except (TypeError, ValueError) as error:
-        raise DimredError(f"the removal's report cannot be written as JSON ({error}); nothing was written") from None
-    try:
-        staging = tempfile.mkdtemp(prefix=".dimred-", dir=_existing_folder(out))
-    except OSError as error:
-        raise DimredError(f"cannot write into {out}: {error.strerror or error}") from None
-    try:
+
+    def images(staging: str) -> None:
         if non_finite_pixels(result.difference):
             raise DimredError("the removal produced non-finite values in difference.exr; nothing was written")
         # The whole-image writer lets go of the interpreter lock while it compresses, so the
@@ -279,16 +366,58 @@ def write_outputs(out: str, result: RemovalResult, report: dict) -> None:
             edited = _finite("edited.exr", result.edited_rows)
             write_exr_rows(os.path.join(staging, "edited.exr"), height, width, edited)
             difference.result()
-        if mask is not None:
-            write_png(os.path.join(staging, "hidden_mask.png"), np.where(mask, 255, 0).astype(np.uint8))
-        with open(os.path.join(staging, "report.json"), "w", encoding="utf-8") as handle:
+
+    writers: dict[str, Callable[[str], None]] = {"": images, "report.json": _json_writer(report)}
+    if mask is not None:
+        writers["hidden_mask.png"] = lambda path: write_png(path, np.where(mask, 255, 0).astype(np.uint8))
+    if result.seen is not None:
+        writers["diagnostics.png"] = lambda path: write_png(path, diagnostics_image(result.seen))
+    # A mask or picture left from an earlier run would describe another result.
+    _write_files(out, writers, stale=("hidden_mask.png", "diagnostics.png"))
+
+
+def diagnostics_image(seen: SeenObject) -> np.ndarray:
+    """The diagnostics picture of the object as the photograph showed it (uint8 RGB)."""
+    from ..segmentation.diagnostics import diagnostics_picture
+
+    outline = seen.segmentation.object if seen.segmentation is not None else seen.shown
+    return diagnostics_picture(seen.image, seen.proxy, outline)
+
+
+def _json_writer(report: dict) -> Callable[[str], None]:
+    """A writer of `report` as JSON, refused (before anything touches the disk) when it is not."""
+    try:
+        payload = json.dumps(report, indent=2, allow_nan=False)
+    except (TypeError, ValueError) as error:
+        raise DimredError(f"the report cannot be written as JSON ({error}); nothing was written") from None
+
+    def write(path: str) -> None:
+        with open(path, "w", encoding="utf-8") as handle:
             handle.write(payload + "\n")
+
+    return write
+
+
+def _write_files(out: str, writers: dict[str, Callable[[str], None]], *, stale: Sequence[str] = ()) -> None:
+    """Write files into `out`, all or nothing: each writer gets its path in a hidden staging
+    folder (the writer of "" gets the folder itself, for several files), made inside `out` when
+    it exists, else in its deepest existing parent, so the final renames stay on one file
+    system; they are moved in only when all are complete, and files in `stale` that this run
+    did not write are removed then. A failure leaves `out` and earlier results as they were."""
+    try:
+        staging = tempfile.mkdtemp(prefix=".dimred-", dir=_existing_folder(out))
+    except OSError as error:
+        raise DimredError(f"cannot write into {out}: {error.strerror or error}") from None
+    try:
+        for name, writer in writers.items():
+            writer(os.path.join(staging, name) if name else staging)
         os.makedirs(out, exist_ok=True)
-        if mask is None:
-            # A mask left from an earlier run would describe a region this result filled.
-            with contextlib.suppress(FileNotFoundError):
-                os.unlink(os.path.join(out, "hidden_mask.png"))
-        for name in os.listdir(staging):
+        written = set(os.listdir(staging))
+        for name in stale:
+            if name not in written:
+                with contextlib.suppress(FileNotFoundError):
+                    os.unlink(os.path.join(out, name))
+        for name in written:
             os.replace(os.path.join(staging, name), os.path.join(out, name))
     except OSError as error:
         raise DimredError(f"cannot write into {out}: {error.strerror or error}") from None

@@ -22,11 +22,13 @@ from ..errors import DimredError
 from ..light.radiosity import LUMA
 from ..quality import Params, rough
 from ..removal import RemovalResult, Solution, finish, finish_full_size, solve, solve_lighting, traced_scene
-from ..removal.sequence import STAGES
+from ..removal.sequence import STAGES, photographed
 from ..removal.target import object_index
 from ..removal.working import downsample, upsample, working_size
 from ..report import Report
 from ..scene import SceneData
+from ..segmentation.seen import SeenObject
+from ..segmentation.user_mask import UserMask
 from .appearance import Carried, carry
 from .fixedview import Move
 from .placement import Placement, place
@@ -45,23 +47,26 @@ class _Pass:
 
 
 def relocate(scene: SceneData, object_name: str, move: Move, *, planes: list[str] | tuple[str, ...] = (),
-             params: Params | None = None, callbacks: RunCallbacks = NO_CALLBACKS) -> RemovalResult:
-    """Move `object_name` by `move` in the panorama: removed at its old place, inserted at the
-    new one with its shadow and reflected light. `callbacks.preview` gets difference images as
-    for a removal, then one after each insertion pass."""
+             params: Params | None = None, callbacks: RunCallbacks = NO_CALLBACKS,
+             mask: UserMask | None = None) -> RemovalResult:
+    """Move `object_name` by `move` in the panorama: removed at its old place (where the
+    photograph shows it, `mask` added or taken away), inserted at the new one with its shadow
+    and reflected light. `callbacks.preview` gets difference images as for a removal, then
+    one after each insertion pass."""
     params = params or Params()
     target = object_index(scene, object_name)
     if not (np.asarray(scene.tri_object) == target).any():
         raise DimredError(f"'{object_name}' has no faces to move")
     height, width = scene.hdri.shape[:2]
     size = working_size(width, height, max_width=params.working_width)
+    seen = photographed(scene, object_name, params, Report(), mask=mask)
     if size == (width, height):
-        return _relocated(scene, object_name, move, target, planes, params, callbacks).result
+        return _relocated(scene, object_name, move, target, planes, params, callbacks, seen).result
     # The moved object's pixels are carried from the working copy, where the move is solved;
     # the removal at its old place runs at full resolution (its fill as sharp as the panorama),
     # and the insertion's change is upsampled onto it.
     small = _relocated(replace(scene, hdri=downsample(scene.hdri, *size)), object_name, move, target, planes, params,
-                       callbacks.scaled(0.0, 0.75, ""))
+                       callbacks.scaled(0.0, 0.75, ""), seen)
     # The removal's solution on the working copy is the one the relocation already solved.
     full_callbacks = callbacks.scaled(0.75, 1.0, "removal at full resolution: ")
     removal = finish_full_size(small.removal, scene.hdri, Report(full_callbacks.progress, stages=4), full_callbacks)
@@ -70,7 +75,7 @@ def relocate(scene: SceneData, object_name: str, move: Move, *, planes: list[str
               "full_resolution_removal_seconds": removal.report["seconds"]}
     return RemovalResult(difference=removal.difference,
                          hidden_mask=removal.hidden_mask | upsample(small.result.hidden_mask, height, width),
-                         report=report, hdri=scene.hdri)
+                         report=report, hdri=scene.hdri, seen=seen)
 
 
 @dataclass(frozen=True)
@@ -85,8 +90,8 @@ class _Relocated:
 
 
 def _relocated(scene: SceneData, object_name: str, move: Move, target: int, planes: list[str] | tuple[str, ...],
-               params: Params, callbacks: RunCallbacks) -> _Relocated:
-    """The relocation at the panorama's own size."""
+               params: Params, callbacks: RunCallbacks, seen: SeenObject | None) -> _Relocated:
+    """The relocation at the panorama's own size, removing the object where `seen` shows it."""
     passes = params.insertion_passes
     if passes < 1:
         raise DimredError(f"insertion_passes must be at least 1, got {passes}")
@@ -95,7 +100,9 @@ def _relocated(scene: SceneData, object_name: str, move: Move, target: int, plan
 
     removal_callbacks = callbacks.scaled(0.0, share, "removal: ")
     rep = Report(removal_callbacks.progress, stages=STAGES)
-    old = solve(scene, object_name, planes, params, rep, removal_callbacks)
+    if seen is not None:
+        rep.info["segmentation"] = seen.summary()
+    old = solve(scene, object_name, planes, params, rep, removal_callbacks, seen=seen)
     removed = finish(old, rep, removal_callbacks)
 
     photo = np.asarray(scene.hdri, dtype=np.float64)
@@ -133,7 +140,7 @@ def _relocated(scene: SceneData, object_name: str, move: Move, target: int, plan
     hidden[carried.pix] = True
     report = _relocation_report(removed.report, steps, insertion.as_dict(), move, placement, carried, passes)
     result = RemovalResult(difference=difference, hidden_mask=hidden.reshape(photo.shape[:2]), report=report,
-                           hdri=photo)
+                           hdri=photo, seen=seen)
     return _Relocated(result, (current - without).reshape(photo.shape).astype(np.float32), old)
 
 

@@ -61,7 +61,7 @@ def full_resolution(solution: Solution, hdri: np.ndarray, rep: Report, callbacks
     maps = working_maps(solution)
     with rep.stage("window"):
         window = object_window(solution.geo, solution.target, solution.traced.hidden_map,
-                               _exemplar_extent(solution), full, maps)
+                               _exemplar_extent(solution), full, maps, solution.seen)
     if window is not None:
         rep.info["object_window"] = list(window.hidden.shape[::-1])  # width, height
     apply = ~solution.traced.hidden_h & ~solution.room.pixels.emitter_h
@@ -221,7 +221,7 @@ class _BandPixels:
         wc = np.tile(np.arange(w), len(inside))
         pixels.window_index, pixels.window_rows, pixels.window_cols = index, wr, wc
         pixels.known[index] = True
-        pixels.hidden[index] = window.hidden[wr, wc]
+        pixels.hidden[index] = window.hidden[wr, wc] | window.kept[wr, wc]
         pixels.ring[index] = window.ring[wr, wc]
         pixels.tri[index] = window.tri[wr, wc]
         pixels.bary[index] = window.bary[wr, wc]

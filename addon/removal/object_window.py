@@ -10,6 +10,8 @@ from ..geometry import latlong
 from ..geometry.mesh import Geometry
 from ..geometry.planeraster import Frame
 from ..geometry.raycast import trace_panorama
+from ..geometry.span import pixel_span
+from ..segmentation.seen import SeenObject
 from .target import Target
 from .working_maps import WorkingMaps, neighbours, surfaces_seen
 
@@ -24,7 +26,8 @@ class ObjectWindow:
     """(h, w) arrays over `frame`: the full-resolution pixels around the object."""
 
     frame: Frame
-    hidden: np.ndarray  # bool: filled (the object and its silhouette, one pixel wide)
+    hidden: np.ndarray  # bool: filled (the object as photographed and its silhouette, one pixel wide)
+    kept: np.ndarray  # bool: the proxy is the first hit but the photograph shows no object (left as it is)
     ring: np.ndarray  # bool: not hidden, within a few pixels of it
     on_object: np.ndarray  # bool: the object is the first hit
     tri: np.ndarray  # int32: what the pixel sees without the object (-1 for nothing)
@@ -39,11 +42,11 @@ class ObjectWindow:
 
 
 def object_window(geo: Geometry, target: Target, hidden_working: np.ndarray, cover: np.ndarray | None,
-                  full: tuple[int, int], maps: WorkingMaps) -> ObjectWindow | None:
+                  full: tuple[int, int], maps: WorkingMaps, seen: SeenObject | None = None) -> ObjectWindow | None:
     """The window around the pixels the working panorama hides (`hidden_working`, (h, w)) and
     the directions (N, 3) it must `cover` as well (the fill's exemplar), at most
     _MAX_PIXELS large, traced at the full resolution `full` (height, width); None when
-    nothing is hidden."""
+    nothing is hidden. The pixels `seen` shows the object in are filled (default: the proxy's)."""
     if not hidden_working.any():
         return None
     height, width = full
@@ -51,8 +54,8 @@ def object_window(geo: Geometry, target: Target, hidden_working: np.ndarray, cov
     wanted = hidden_working.copy()
     if cover is not None and len(cover):
         wanted[latlong.uv_to_pixel(*latlong.direction_to_uv(cover), w, h)] = True
-    must = _span(hidden_working, _PAD)
-    want = _span(wanted, _PAD)
+    must = pixel_span(hidden_working, _PAD)
+    want = pixel_span(wanted, _PAD)
     # The wanted columns as a run that starts left of the object's own (they hold them).
     left = (must[2] - want[2]) % w if want[3] < w else (w - must[3]) // 2
     want = (want[0], want[1], must[2] - left, want[3])
@@ -84,33 +87,14 @@ def object_window(geo: Geometry, target: Target, hidden_working: np.ndarray, cov
     for start in range(0, shape[0], block):
         rows_b = row_start + np.arange(start, min(start + block, shape[0]))
         near = neighbours(np.repeat(rows_b, ncols), np.tile(cols_full, len(rows_b)), full, maps)
-        seen = surfaces_seen(directions[start:start + len(rows_b)].reshape(-1, 3), near.nearest, geo, maps)
-        tri[start:start + len(rows_b)] = seen.tri.reshape(-1, ncols)
-        distance[start:start + len(rows_b)] = seen.distance.reshape(-1, ncols)
-        bary[start:start + len(rows_b)] = seen.bary.reshape(-1, ncols, 2)
+        found = surfaces_seen(directions[start:start + len(rows_b)].reshape(-1, 3), near.nearest, geo, maps)
+        tri[start:start + len(rows_b)] = found.tri.reshape(-1, ncols)
+        distance[start:start + len(rows_b)] = found.distance.reshape(-1, ncols)
+        bary[start:start + len(rows_b)] = found.bary.reshape(-1, ncols, 2)
     on_object = object_distance < distance
-    hidden = latlong.dilate(on_object, 1)
-    ring = latlong.dilate(hidden, _RING) & ~hidden
-    return ObjectWindow(frame=Frame(row_start, col_start, height, width), hidden=hidden, ring=ring,
-                        on_object=on_object, tri=tri, distance=distance, bary=bary, object_distance=object_distance,
-                        object_tri=object_tri)
-
-
-def _span(mask: np.ndarray, pad: int) -> tuple[int, int, int, int]:
-    """(first row, end row, first column, columns) of the working pixels of `mask` and `pad`
-    more around; the columns wrap (all of them when the span would close the circle)."""
-    h, w = mask.shape
-    rows = np.flatnonzero(mask.any(axis=1))
-    col0, cols = _column_span(mask.any(axis=0))
-    col0, cols = (0, w) if cols + 2 * pad >= w else (col0 - pad, cols + 2 * pad)
-    return max(0, int(rows[0]) - pad), min(h, int(rows[-1]) + 1 + pad), col0, cols
-
-
-def _column_span(columns: np.ndarray) -> tuple[int, int]:
-    """(first, count) of the shortest circular run of columns holding every True one."""
-    w = len(columns)
-    on = np.flatnonzero(columns)
-    gaps = np.diff(np.concatenate([on, on[:1] + w]))
-    widest = int(gaps.argmax())
-    first = int(on[(widest + 1) % len(on)])
-    return first, w - int(gaps[widest]) + 1
+    frame = Frame(row_start, col_start, height, width)
+    hidden = latlong.dilate(on_object if seen is None else seen.in_frame(frame, shape), 1)
+    kept = on_object & ~hidden
+    ring = latlong.dilate(hidden, _RING) & ~hidden & ~kept
+    return ObjectWindow(frame=frame, hidden=hidden, kept=kept, ring=ring, on_object=on_object, tri=tri,
+                        distance=distance, bary=bary, object_distance=object_distance, object_tri=object_tri)

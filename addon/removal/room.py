@@ -196,7 +196,10 @@ def _pixel_lookup(traced: Traced, patches: Patches, receivers: Receivers
 def _measured(hdri: np.ndarray, traced: Traced, patch_h: np.ndarray, areas: np.ndarray, rep: Report
               ) -> tuple[np.ndarray, np.ndarray]:
     """(P, 3) radiosity of the patches as the panorama shows them (the area-weighted mean of
-    their pixels) and (P,) whether enough of each is seen to count as measured."""
+    their pixels) and (P,) whether enough of each is seen to count as measured. A pixel the
+    photograph shows the object in though the proxy misses it would lend the surface behind it
+    the object's colour, and one of the proxy the photograph shows no object in the object
+    the surface's: neither counts."""
     width, height, hp = traced.width, traced.height, traced.hp
     cos = np.abs(np.einsum("ij,ij->i", traced.hits.directions.reshape(-1, 3)[hp], traced.normals_h))
     guarded = int((cos < MIN_COS).sum())
@@ -205,6 +208,7 @@ def _measured(hdri: np.ndarray, traced: Traced, patch_h: np.ndarray, areas: np.n
     solid = np.broadcast_to(latlong.pixel_solid_angles(width, height), (height, width)).ravel()[hp]
     dist = traced.hits.distance.ravel()[hp]
     weight = solid * dist**2 / np.maximum(cos, MIN_COS)
+    weight[traced.beyond_h | traced.kept_h] = 0.0
     b, cover = patch_radiosity(traced.panorama_rows(hdri), patch_h, weight, areas)
     return b, cover >= _VISIBLE
 

@@ -1,5 +1,6 @@
 """The removal as a sequence of stages, each a function of the previous stages' frozen results:
 
+    seen = photographed(...)            the object as the photograph shows it (segmented)
     geo, target = prepare(...)          the scene in the probe frame, the object to remove
     traced = trace(...)                 what every pixel sees, with the object and without it
     solution = solve_lighting(...)      occluders, room, first order, propagation, local light
@@ -15,10 +16,12 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..callbacks import NO_CALLBACKS, RunCallbacks
-from ..geometry.mesh import Geometry
+from ..geometry.mesh import Geometry, build_geometry
 from ..quality import Params
 from ..report import Report
 from ..scene import SceneData
+from ..segmentation.seen import SeenObject, seen_object
+from ..segmentation.user_mask import UserMask
 from .compose import compose
 from .fill import fill_hidden, working_revealed
 from .first_order import first_order
@@ -28,11 +31,11 @@ from .occlusion import occluders
 from .propagation import propagate_change
 from .room import solve_room
 from .solution import Solution
-from .target import Target, prepare
+from .target import Target, object_index, prepare
 from .trace import Traced, trace
 from .working import downsample, working_size
 
-STAGES = 8  # the stages a removal reports progress for
+STAGES = 9  # the stages a removal reports progress for
 
 
 @dataclass(frozen=True)
@@ -41,6 +44,7 @@ class RemovalResult:
     hidden_mask: np.ndarray  # (H, W) bool: pixels that showed the object
     report: dict
     hdri: np.ndarray  # (H, W, 3) the panorama the difference applies to
+    seen: SeenObject | None = None  # the object as the photograph showed it (for the diagnostics picture)
 
     @property
     def edited(self) -> np.ndarray:
@@ -53,20 +57,39 @@ class RemovalResult:
         return (self.hdri[start:stop] + self.difference[start:stop]).astype(np.float32, copy=False)
 
 
+def photographed(scene: SceneData, object_name: str, params: Params, rep: Report, *,
+                 mask: UserMask | None = None) -> SeenObject | None:
+    """The object as the scene's panorama shows it, segmented around its proxy, with the
+    artist's `mask` applied; None when no pixel sees it, or when the preset's band is 0 and
+    there is no mask (the proxy's silhouette is filled then)."""
+    index = object_index(scene, object_name)
+    if params.segmentation_band <= 0 and mask is None:
+        return None
+    with rep.stage("segmentation"):
+        geo = build_geometry(scene.triangles, scene.tri_object, scene.object_names, scene.center, scene.rotation)
+        if not (geo.tri_object == index).any():
+            return None
+        band = params.segmentation_band
+        return seen_object(scene.hdri, geo, index, segment=band > 0, band=max(band, 0.0), mask=mask, rep=rep)
+
+
 def traced_scene(scene: SceneData, object_name: str, planes: list[str] | tuple[str, ...], params: Params,
-                 rep: Report, callbacks: RunCallbacks, *, fill: bool = True) -> tuple[Geometry, Target, Traced]:
+                 rep: Report, callbacks: RunCallbacks, *, fill: bool = True, seen: SeenObject | None = None
+                 ) -> tuple[Geometry, Target, Traced]:
     """The geometry, the target and what the pixels see. Without `fill` (an insertion has
-    nothing to fill) the pixels around the object are relit like the rest."""
+    nothing to fill) the pixels around the object are relit like the rest; with it, the
+    pixels `seen` shows the object in are filled (default: the proxy's silhouette)."""
     geo, target = prepare(scene, object_name, planes, params, rep)
     height, width = scene.hdri.shape[:2]
     with rep.stage("trace"):
-        traced = trace(geo, target, width, height, fill=fill, rep=rep)
+        shown = None if seen is None else seen.whole(height, width)
+        traced = trace(geo, target, width, height, fill=fill, rep=rep, shown=shown)
     callbacks.check()
     return geo, target, traced
 
 
 def solve_lighting(hdri: np.ndarray, geo: Geometry, target: Target, traced: Traced, params: Params, rep: Report,
-                   callbacks: RunCallbacks) -> Solution:
+                   callbacks: RunCallbacks, *, seen: SeenObject | None = None) -> Solution:
     """The light before and after the removal at every hit pixel, the room's radiosity read
     from `hdri`; the stages are timed in `rep`."""
     with rep.stage("occluders"):
@@ -82,14 +105,15 @@ def solve_lighting(hdri: np.ndarray, geo: Geometry, target: Target, traced: Trac
     with rep.stage("local"):
         local = local_light(geo, target, traced, occlusion, first.room, propagation, params, rep, callbacks)
     return Solution(hdri=hdri, params=params, geo=geo, target=target, traced=traced, occlusion=occlusion,
-                    room=first.room, db=propagation.db, split=propagation.split, e_h=local.e_h, de_h=local.de_h)
+                    room=first.room, db=propagation.db, split=propagation.split, e_h=local.e_h, de_h=local.de_h,
+                    seen=seen)
 
 
 def solve(scene: SceneData, object_name: str, planes: list[str] | tuple[str, ...], params: Params, rep: Report,
-          callbacks: RunCallbacks = NO_CALLBACKS, *, fill: bool = True) -> Solution:
+          callbacks: RunCallbacks = NO_CALLBACKS, *, fill: bool = True, seen: SeenObject | None = None) -> Solution:
     """Every stage of the removal up to the new irradiance of each pixel."""
-    geo, target, traced = traced_scene(scene, object_name, planes, params, rep, callbacks, fill=fill)
-    return solve_lighting(scene.hdri, geo, target, traced, params, rep, callbacks)
+    geo, target, traced = traced_scene(scene, object_name, planes, params, rep, callbacks, fill=fill, seen=seen)
+    return solve_lighting(scene.hdri, geo, target, traced, params, rep, callbacks, seen=seen)
 
 
 def finish(solution: Solution, rep: Report, callbacks: RunCallbacks = NO_CALLBACKS) -> RemovalResult:
@@ -113,16 +137,18 @@ def finish(solution: Solution, rep: Report, callbacks: RunCallbacks = NO_CALLBAC
     else:
         d_revealed = np.zeros((0, 3))
         rep.skip("synthesis", "the object is not visible from the probe centre: no hidden region to fill"
-                 if not traced.hidden_h.any() else "nothing is behind the object to fill")
+                 if not traced.hidden_map.any() else "nothing is behind the object to fill")
     difference = difference_image(d_revealed)
-    rep.info["hidden_region_filled"] = bool(len(revealed) == traced.hidden_h.sum())
+    rep.info["hidden_region_filled"] = bool(len(revealed) == traced.hidden_map.sum())
     return RemovalResult(difference=difference, hidden_mask=traced.hidden_map, report=rep.as_dict(),
-                         hdri=solution.hdri)
+                         hdri=solution.hdri, seen=solution.seen)
 
 
 def remove(scene: SceneData, object_name: str, *, planes: list[str] | tuple[str, ...] = (),
-           params: Params | None = None, callbacks: RunCallbacks = NO_CALLBACKS) -> RemovalResult:
-    """Remove `object_name`'s shadows and reflected light from the scene's panorama.
+           params: Params | None = None, callbacks: RunCallbacks = NO_CALLBACKS,
+           mask: UserMask | None = None) -> RemovalResult:
+    """Remove `object_name`'s shadows and reflected light from the scene's panorama, and fill
+    where the photograph shows it (segmented around its proxy, `mask` added or taken away).
 
     `callbacks.preview(difference)` gets (H, W, 3) float32 difference images before the
     result: the lighting corrected with the hidden region roughly filled, then refined level
@@ -134,11 +160,13 @@ def remove(scene: SceneData, object_name: str, *, planes: list[str] | tuple[str,
     # Above the working width the compose stage gives way to downsample, window, upsample and refine.
     rep = Report(callbacks.progress, stages=STAGES + 3 * full_size)
     rep.info["working_resolution"] = list(size)
+    seen = photographed(scene, object_name, params, rep, mask=mask)
+    callbacks.check()
     if not full_size:
-        return finish(solve(scene, object_name, planes, params, rep, callbacks), rep, callbacks)
+        return finish(solve(scene, object_name, planes, params, rep, callbacks, seen=seen), rep, callbacks)
     with rep.stage("downsample"):
         working = replace(scene, hdri=downsample(scene.hdri, *size))
-    solution = solve(working, object_name, planes, params, rep, callbacks)
+    solution = solve(working, object_name, planes, params, rep, callbacks, seen=seen)
     if callbacks.preview is not None:
         callbacks.show(_difference_image(solution.traced, compose(solution, Report())))
     return finish_full_size(solution, scene.hdri, rep, callbacks)
@@ -149,7 +177,8 @@ def finish_full_size(solution: Solution, hdri: np.ndarray, rep: Report, callback
     """The edited full-resolution panorama `hdri` from a removal solved on its working copy."""
     full = full_resolution(solution, hdri, rep, callbacks)
     rep.info["hidden_region_filled"] = full.filled
-    return RemovalResult(difference=full.difference, hidden_mask=full.hidden_mask, report=rep.as_dict(), hdri=hdri)
+    return RemovalResult(difference=full.difference, hidden_mask=full.hidden_mask, report=rep.as_dict(), hdri=hdri,
+                         seen=solution.seen)
 
 
 def _difference_image(traced: Traced, d_h: np.ndarray) -> np.ndarray:

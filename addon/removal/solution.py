@@ -9,6 +9,7 @@ from ..callbacks import RunCallbacks
 from ..geometry.mesh import Geometry
 from ..light.split import Split
 from ..quality import Params
+from ..segmentation.seen import SeenObject
 from .interpolation import interpolate
 from .irradiance import fine_light
 from .occlusion import Occlusion
@@ -22,7 +23,8 @@ class Solution:
     """Every stage's result up to the new irradiance of each pixel: the panorama the room's
     radiosity was read from, the geometry and target, what the pixels see, the occluders, the
     room (as the first order left it), the change db (P, 3) of its patches with every bounce,
-    the split patches, and per hit pixel E (N, 3) with the object and the change dE (N, 3)."""
+    the split patches, per hit pixel E (N, 3) with the object and the change dE (N, 3), and the
+    object as the photograph shows it."""
 
     hdri: np.ndarray
     params: Params
@@ -35,6 +37,7 @@ class Solution:
     split: Split
     e_h: np.ndarray
     de_h: np.ndarray
+    seen: SeenObject | None = None  # the object as the photograph shows it (None: the proxy's silhouette)
 
     def irradiance(self, tri: np.ndarray, bary: np.ndarray, callbacks: RunCallbacks) -> np.ndarray:
         """(N, 3) E with the object in place at the points (geometry triangle, barycentric

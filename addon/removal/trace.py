@@ -40,8 +40,10 @@ class Traced:
     obj_h: np.ndarray  # (N,) object it sees
     points_h: np.ndarray  # (N, 3) the point it sees, probe frame
     normals_h: np.ndarray  # (N, 3) the normal there
-    hidden_h: np.ndarray  # (N,) bool: filled rather than relit (the object and its silhouette)
-    hidden_map: np.ndarray  # (H, W) bool: the same per panorama pixel
+    hidden_h: np.ndarray  # (N,) bool: not relit: filled (the object and its silhouette) or kept
+    kept_h: np.ndarray  # (N,) bool: the proxy's pixels the photograph does not show as the object (left as they are)
+    beyond_h: np.ndarray  # (N,) bool: filled, the photograph showing the object there, the proxy a pixel away or more
+    hidden_map: np.ndarray  # (H, W) bool: the filled pixels per panorama pixel
     behind: Behind
 
     @property
@@ -57,34 +59,43 @@ class Traced:
         return image.reshape(-1, 3)[self.hp].astype(np.float64)
 
 
-def trace(geo: Geometry, target: Target, width: int, height: int, *, fill: bool, rep: Report) -> Traced:
-    """What each pixel sees. With `fill` (a removal), the pixels around the object count as
-    hidden too (they are filled, not relit), and what is behind the hidden ones is traced."""
+def trace(geo: Geometry, target: Target, width: int, height: int, *, fill: bool, rep: Report,
+          shown: np.ndarray | None = None) -> Traced:
+    """What each pixel sees. With `fill` (a removal), the pixels the object shows in (`shown`,
+    (H, W) bool: the photograph's object, default the proxy's silhouette) and the pixels around
+    them are hidden (filled, not relit), and what is behind them is traced. Pixels of the
+    proxy outside `shown` are kept as the photograph shows them."""
     hits = trace_panorama(geo.triangles, width, height)
     flat_tri = hits.tri.ravel()
     hp = np.flatnonzero(flat_tri >= 0)
     tri_h = flat_tri[hp]
     obj_h = geo.tri_object[tri_h]
-    # A pixel on the object's silhouette mixes it with what is behind; the ratio form would
-    # scale the object's share of it too, so it is filled like the pixels the object covers.
     on_object = np.zeros(height * width, dtype=bool)
     on_object[hp[obj_h == target.index]] = True
-    hidden = on_object.reshape(height, width)
+    on_object = on_object.reshape(height, width)
+    filled = on_object if shown is None or not fill else shown
+    # A pixel on the object's silhouette mixes it with what is behind; the ratio form would
+    # scale the object's share of it too, so it is filled like the pixels the object covers.
     if fill:
-        hidden = latlong.dilate(hidden, 1)
-    hidden_h = hidden.ravel()[hp]
+        filled = latlong.dilate(filled, 1)
+    filled_h = filled.ravel()[hp]
+    kept_h = on_object.ravel()[hp] & ~filled_h
+    beyond_h = filled_h & ~latlong.dilate(on_object, 1).ravel()[hp]
+    hidden_h = filled_h | kept_h
     hidden_map = np.zeros(height * width, dtype=bool)
-    hidden_map[hp[hidden_h]] = True
+    hidden_map[hp[filled_h]] = True
     missing = len(flat_tri) - len(hp)
     if missing:
         rep.warn(f"{missing} panorama pixels see no proxy geometry (open room?); they are left unchanged")
-    rep.info["hidden_pixels"] = int(hidden_h.sum())
+    rep.info["hidden_pixels"] = int(filled_h.sum())
+    if kept_h.any():
+        rep.info["kept_object_pixels"] = int(kept_h.sum())
     behind = Behind.nothing(height * width)
-    if fill and hidden_h.any():
-        behind = _behind(geo, target, width, height, hp, hidden_h, rep)
+    if fill and filled_h.any():
+        behind = _behind(geo, target, width, height, hp, filled_h, rep)
     return Traced(hits=hits, hp=hp, tri_h=tri_h, obj_h=obj_h,
                   points_h=hits.points.reshape(-1, 3)[hp], normals_h=geo.normals[tri_h], hidden_h=hidden_h,
-                  hidden_map=hidden_map.reshape(height, width), behind=behind)
+                  kept_h=kept_h, beyond_h=beyond_h, hidden_map=hidden_map.reshape(height, width), behind=behind)
 
 
 def _behind(geo: Geometry, target: Target, width: int, height: int, hp: np.ndarray, hidden_h: np.ndarray,

@@ -3,7 +3,9 @@ previews out (no bpy).
 
 The operator gathers a `RemovalRequest` on the main thread and runs `run` either in a worker
 thread or, in background mode, directly. A request with a `move` relocates the object (removal
-at the photographed place, insertion at the moved one) and is otherwise handled the same.
+at the photographed place, insertion at the moved one) and is otherwise handled the same; the
+artist's mask and Align to Photo (`align`, `fit_height`) go to the engine as they are, and the
+outcome keeps the object as the photograph showed it, for the diagnostics picture.
 Removals compose: the request names the differences of the objects removed before (`base`),
 the engine works on HDRI + base, and the world layer shows base + this run's difference. Files
 are written under temporary names next to their final paths and only `Staged.commit` (on the
@@ -34,6 +36,8 @@ from ..pipeline import relocate_object, remove_object
 from ..quality import DEFAULT_QUALITY
 from ..relocation.fixedview import Move
 from ..scene import SceneData
+from ..segmentation.seen import SeenObject
+from ..segmentation.user_mask import UserMask
 from . import small_copy
 from .preview import Previews
 
@@ -53,6 +57,9 @@ class RemovalRequest:
     overrides: dict = field(default_factory=dict)  # engine parameters that replace the preset's
     move: Move | None = None  # relocate the object by this move instead of removing it
     cache_folder: str = ""  # where small copies of the files are kept between runs ("": nowhere)
+    mask: UserMask | None = None  # the artist's additions to and cuts from the region filled
+    align: bool = False  # fit the proxy's pose to the photograph first (Align to Photo)
+    fit_height: bool = False  # ... its support's height instead of its scale
 
 
 @dataclass
@@ -60,6 +67,15 @@ class Staged:
     """Files written under temporary names, waiting for `commit` or `discard`."""
 
     moves: list[tuple[str, str]] = field(default_factory=list)  # (temporary, final)
+
+    def write(self, path: str, writer: Callable[[str], object]) -> str:
+        """`writer(temporary)` the file that `commit` will move to `path`; the temporary name."""
+        os.makedirs(os.path.dirname(path) or ".", exist_ok=True)
+        folder, name = os.path.split(path)
+        temporary = os.path.join(folder, f".{name}.{secrets.token_hex(4)}.staged{os.path.splitext(name)[1]}")
+        self.moves.append((temporary, path))
+        writer(temporary)
+        return temporary
 
     def commit(self) -> None:
         for temporary, final in self.moves:
@@ -77,6 +93,7 @@ class Staged:
 class RemovalOutcome:
     report: dict
     staged: Staged  # this removal's own difference and the layer (base + own), to commit
+    seen: SeenObject | None = None  # the object as the photograph showed it (the diagnostics picture's)
 
 
 def loaded(scene: SceneData) -> SceneData:
@@ -111,13 +128,14 @@ def run(request: RemovalRequest, callbacks: RunCallbacks = NO_CALLBACKS) -> Remo
         engine_callbacks = callbacks.mapped_preview(previews.of_difference)
     engine = remove_object if request.move is None else functools.partial(relocate_object, move=request.move)
     result = engine(scene, request.object_name, planes=request.planes, quality=request.quality,
-                    callbacks=engine_callbacks, **request.overrides)
+                    callbacks=engine_callbacks, mask=request.mask, align=request.align,
+                    fit_height=request.fit_height, **request.overrides)
     del scene  # the panorama: the layer needs only the difference and the base
-    difference, report = result.difference, result.report
+    difference, report, seen = result.difference, result.report, result.seen
     del result
     callbacks.check()
     _progress(callbacks, "writing", 1.0)
-    return RemovalOutcome(report=report, staged=_write(request, difference))
+    return RemovalOutcome(report=report, staged=_write(request, difference), seen=seen)
 
 
 def _progress(callbacks: RunCallbacks, stage: str, fraction: float = 0.0) -> None:
@@ -204,17 +222,17 @@ def _write(request: RemovalRequest, difference: np.ndarray) -> Staged:
     try:
         own = ""
         if request.own_path:
-            own = _stage(staged, request.own_path, lambda temporary: write_exr(temporary, difference))
+            own = staged.write(request.own_path, lambda temporary: write_exr(temporary, difference))
             if request.cache_folder:
                 small_copy.store(request.own_path, small_copy.of_image(difference), request.cache_folder,
                                  stat=os.stat(own))
         if request.layer_path and own and not request.base:
-            _stage(staged, request.layer_path, lambda temporary: shutil.copyfile(own, temporary))
+            staged.write(request.layer_path, lambda temporary: shutil.copyfile(own, temporary))
         elif request.layer_path:
             # In place: the engine's array is no one else's, and the own file is written.
             for layer in request.base:
                 difference += _pixels(layer, difference.shape)
-            _stage(staged, request.layer_path, lambda temporary: write_exr(temporary, difference))
+            staged.write(request.layer_path, lambda temporary: write_exr(temporary, difference))
     except OSError as error:
         staged.discard()
         raise DimredError(f"cannot write the difference image: {error.strerror or error}") from None
@@ -222,13 +240,3 @@ def _write(request: RemovalRequest, difference: np.ndarray) -> Staged:
         staged.discard()
         raise
     return staged
-
-
-def _stage(staged: Staged, path: str, write: Callable[[str], object]) -> str:
-    """`write(temporary)` the file that `staged` will move to `path`; the temporary name."""
-    os.makedirs(os.path.dirname(path) or ".", exist_ok=True)
-    folder, name = os.path.split(path)
-    temporary = os.path.join(folder, f".{name}.{secrets.token_hex(4)}.staged.exr")
-    staged.moves.append((temporary, path))
-    write(temporary)
-    return temporary

@@ -10,7 +10,10 @@ result when it arrives. Every step that touches bpy runs on the main thread and 
 files are decoded and written by the worker (the earlier results too: the session names their
 files, writing packed ones out first), previews are small whatever the panorama's size, and
 the main thread only renames the results into place and points images at them, which Blender
-loads from the files itself.
+loads from the files itself. The diagnostics picture is drawn by the worker too (and staged
+beside the difference when that goes to a file); the main thread copies its pixels into the
+image "Dimred Diagnostics". On success a run with Align to Photo first leaves the object at
+the fitted pose.
 
 Running sessions are kept in `_running` so that file load, unregister and Blender's exit can
 stop and join their threads (the one piece of module state; Blender cannot do it for us).
@@ -33,7 +36,7 @@ from mathutils import Matrix
 
 from ...addon.errors import Cancelled, DimredError
 from ...addon.run.worker import Worker
-from . import warmup, world_layer
+from . import pictures, warmup, world_layer
 
 if TYPE_CHECKING:  # the engine is imported only when a run starts
     from ...addon.callbacks import RunCallbacks
@@ -68,8 +71,8 @@ def layer_filename(world: bpy.types.World) -> str:
     return f"{bpy.path.clean_name(world.name)}_difference.exr"
 
 
-def own_filename(world: bpy.types.World, object_name: str) -> str:
-    return f"{bpy.path.clean_name(world.name)}_{bpy.path.clean_name(object_name)}_difference.exr"
+def own_filename(world: bpy.types.World, object_name: str, kind: str = "difference.exr") -> str:
+    return f"{bpy.path.clean_name(world.name)}_{bpy.path.clean_name(object_name)}_{kind}"
 
 
 def probe_center(settings: bpy.types.PropertyGroup) -> tuple[float, float, float] | None:
@@ -158,6 +161,7 @@ class RemovalSession:
     relative: bool  # the output folder is given relative to the .blend
     photographed: Matrix  # the object's world matrix where the panorama shows it
     temporary_folder: str = ""  # files of this run only: packed results, earlier packed differences
+    diagnostics_path: str = ""  # where the diagnostics picture goes beside the difference ("": nowhere)
     worker: Worker | None = None
     done: bool = False
     stage: str = "starting"
@@ -178,6 +182,7 @@ class RemovalSession:
         `photographed_matrix`)."""
         from ...addon import memory
         from ...addon.blender import reader
+        from ...addon.blender.mask_reader import mask_of_image
         from ...addon.relocation.fixedview import check_move
         from ...addon.run.job import RemovalRequest
 
@@ -206,7 +211,9 @@ class RemovalSession:
         try:
             reader.check_object(scene, target)
             # Refused before any work when the panorama cannot fit (the size from its header).
-            memory.check_fits(*reader.panorama_size(scene), quality=settings.quality)
+            size = reader.panorama_size(scene)
+            memory.check_fits(*size, quality=settings.quality)
+            mask = None if settings.mask_image is None else mask_of_image(settings.mask_image, size)
             names = settings.surface_names()
             for name in names:
                 reader.check_object(scene, name, purpose="used as a target surface")
@@ -221,19 +228,21 @@ class RemovalSession:
                 scene=scene_data, object_name=target, planes=names, quality=settings.quality, base=base,
                 own_path=os.path.join(folder, own_filename(world, target)),
                 layer_path=os.path.join(folder, layer_filename(world)), overrides=settings.overrides(), move=move,
-                previous=previous, cache_folder=warmup.folder(),
+                previous=previous, cache_folder=warmup.folder(), mask=mask, align=settings.align_first,
+                fit_height=settings.fit_height,
             )
         except BaseException:
             if scratch:
                 shutil.rmtree(scratch, ignore_errors=True)
             raise
+        diagnostics = "" if pack else os.path.join(folder, own_filename(world, target, "diagnostics.png"))
         index = _index(settings, target)
         later = [r.object_name for r in settings.removals[index + 1:]] if index >= 0 else []
         warnings = [(f"'{', '.join(later)}' were removed after '{target}' with it still in place: "
                      "remove them again for the most accurate result")] if later else []
         return cls(scene_name=scene.name, world_name=world.name, object_name=target, request=request, pack=pack,
                    relative=settings.output_dir.strip().startswith("//") and not pack, photographed=photographed,
-                   temporary_folder=scratch, warnings=warnings)
+                   temporary_folder=scratch, warnings=warnings, diagnostics_path=diagnostics)
 
     # -- computing ------------------------------------------------------------------------
     def run_here(self, context: bpy.types.Context) -> bool:
@@ -241,29 +250,39 @@ class RemovalSession:
         from ...addon.callbacks import NO_CALLBACKS
 
         try:
-            outcome = self._task()(NO_CALLBACKS)
+            computed = self._task()(NO_CALLBACKS)
         except DimredError as error:
             return self._fail(context, str(error))
-        return self._apply(context, outcome)
+        return self._apply(context, computed)
 
     def start(self) -> None:
         """Compute in a worker thread; `tick` polls it."""
         self.worker = Worker(self._task()).start()
         _running.append(self)
 
-    def _task(self) -> Callable[[RunCallbacks], RemovalOutcome]:
+    def _task(self) -> Callable[[RunCallbacks], Computed]:
         """The run as a function of its callbacks: first waiting for the small copy of the
         panorama if a thread is making it (its first preview needs it, and reading the file
-        meanwhile would read it twice)."""
+        meanwhile would read it twice); then the diagnostics picture, staged beside the
+        difference when that goes to a file."""
+        from ...addon.io.exr import write_png
         from ...addon.run.job import run
 
-        request = self.request
+        request, path = self.request, self.diagnostics_path
         warming = warmup.running(request.scene.hdri_path) if request.scene.hdri is None else None
 
-        def task(callbacks: RunCallbacks) -> RemovalOutcome:
+        def task(callbacks: RunCallbacks) -> Computed:
             while warming is not None and not warming.join(WAIT_INTERVAL):
                 callbacks.check()
-            return run(request, callbacks)
+            outcome = run(request, callbacks)
+            picture = pictures.diagnostics_picture(outcome.seen)
+            if picture is not None and path:
+                try:
+                    outcome.staged.write(path, lambda temporary: write_png(temporary, picture.image))
+                except OSError as error:
+                    outcome.staged.discard()
+                    raise DimredError(f"cannot write the diagnostics picture: {error.strerror or error}") from None
+            return Computed(outcome, picture)
 
         return task
 
@@ -319,7 +338,8 @@ class RemovalSession:
         world.update_tag()
         _redraw(context)
 
-    def _apply(self, context: bpy.types.Context, outcome: RemovalOutcome) -> bool:
+    def _apply(self, context: bpy.types.Context, computed: Computed) -> bool:
+        outcome = computed.outcome
         world = self._world()
         scene = bpy.data.scenes.get(self.scene_name)
         if world is None or scene is None:
@@ -346,6 +366,9 @@ class RemovalSession:
         report.setdefault("warnings", []).extend(self.warnings)
         report["layer"] = [r.object_name for r in settings.removals]
         settings.last_report = json.dumps(report)
+        settings.photo_fit = photo_fit(self.object_name, report.get("segmentation"), report.get("alignment"))
+        if computed.picture is not None:
+            pictures.show_diagnostics(computed.picture)
         self.ok = True
         where = "packed into the .blend" if self.pack else f"wrote {request.layer_path}"
         done = f"Removed '{self.object_name}'" if request.move is None else (
@@ -356,17 +379,24 @@ class RemovalSession:
 
     def _place(self, scene: bpy.types.Scene, entry: bpy.types.PropertyGroup, report: dict) -> None:
         """Record the move on the entry and put the object where the new panorama shows it:
-        moved from its photographed place, or back there when a relocated object is removed."""
+        moved from its photographed place, or back there when a relocated object is removed;
+        the photographed place itself corrected first where the run aligned it to the photo."""
         move = self.request.move
         relocated_before = entry.kind == 'RELOCATE'
         entry.kind = 'REMOVE' if move is None else 'RELOCATE'
-        if move is None and not relocated_before:
+        alignment = report.get("alignment") or {}
+        photographed = self.photographed
+        if alignment.get("applied"):
+            correction = Matrix(alignment["matrix"])
+            photographed = correction @ photographed
+            scene.dimred.correct_marked(self.object_name, correction)
+        elif move is None and not relocated_before:
             return
-        placed = self.photographed
+        placed = photographed
         if move is not None:
             entry.yaw, entry.distance_scale = move.yaw, move.distance_scale
-            entry.set_photographed_matrix(self.photographed)
-            placed = Matrix(report["relocation"]["matrix"]) @ self.photographed
+            entry.set_photographed_matrix(photographed)
+            placed = Matrix(report["relocation"]["matrix"]) @ photographed
         obj = scene.objects.get(self.object_name)
         if obj is not None:
             obj.matrix_world = placed
@@ -387,6 +417,19 @@ class RemovalSession:
     def _forget(self) -> None:
         if self in _running:
             _running.remove(self)
+
+
+@dataclass(frozen=True)
+class Computed:
+    """What the worker hands back: the run's outcome and its diagnostics picture."""
+
+    outcome: RemovalOutcome
+    picture: pictures.Picture | None
+
+
+def photo_fit(object_name: str, segmentation: dict | None, alignment: dict | None) -> str:
+    """`scene.dimred.photo_fit`: how the proxy of `object_name` fitted the photograph, as JSON."""
+    return json.dumps({"object": object_name, "segmentation": segmentation, "alignment": alignment})
 
 
 def report_summary(report: dict) -> str:

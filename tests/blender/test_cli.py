@@ -73,10 +73,12 @@ class FakeEngine:
         self.filled, self.difference, self.error = filled, difference, error
         self.calls: list[dict] = []
 
-    def __call__(self, scene_data, object_name, *, planes=(), quality="balanced", callbacks=NO_CALLBACKS):
+    def __call__(self, scene_data, object_name, *, planes=(), quality="balanced", callbacks=NO_CALLBACKS, mask=None,
+                 align=False, fit_height=False):
         progress = callbacks.progress
         self.calls.append(
-            {"scene": scene_data, "object": object_name, "planes": planes, "quality": quality, "progress": progress}
+            {"scene": scene_data, "object": object_name, "planes": planes, "quality": quality, "progress": progress,
+             "mask": mask, "align": align, "fit_height": fit_height}
         )
         if progress is not None:
             progress("synthesis", 0.5)
@@ -339,8 +341,10 @@ def test_module_entry_point_reports_one_line(tmp_path):
 class FakeRelocation(FakeEngine):
     """Stands in for `pipeline.relocate_object`; records the move too."""
 
-    def __call__(self, scene_data, object_name, move, *, planes=(), quality="balanced", callbacks=NO_CALLBACKS):
-        result = super().__call__(scene_data, object_name, planes=planes, quality=quality, callbacks=callbacks)
+    def __call__(self, scene_data, object_name, move, *, planes=(), quality="balanced", callbacks=NO_CALLBACKS,
+                 **options):
+        result = super().__call__(scene_data, object_name, planes=planes, quality=quality, callbacks=callbacks,
+                                  **options)
         self.calls[-1]["move"] = move
         return result
 

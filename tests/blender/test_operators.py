@@ -240,7 +240,7 @@ def test_a_second_object_composes_with_the_first(room, tmp_path, extension, stor
 
     settings = bpy.context.scene.dimred
     settings.storage = storage
-    tiny_scene.mesh_object(bpy, "Crate", *tiny_scene.box_faces((-0.9, -0.8, 0.0), (-0.6, -0.5, 0.3)))
+    tiny_scene.add_crate(bpy, room)
     assert bpy.ops.dimred.remove() == {'FINISHED'}
     settings.target = bpy.data.objects["Crate"]
     assert bpy.ops.dimred.remove() == {'FINISHED'}

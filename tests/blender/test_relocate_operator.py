@@ -135,7 +135,7 @@ def test_relocate_writes_the_layer_moves_the_box_undoes_redoes_and_clears(room, 
 def test_later_removals_see_the_relocated_object_at_its_new_place(room, extension):
     S = extension.operators.support.session
     settings = bpy.context.scene.dimred
-    tiny_scene.mesh_object(bpy, "Crate", *tiny_scene.box_faces((-0.9, -0.8, 0.0), (-0.6, -0.5, 0.3)))
+    tiny_scene.add_crate(bpy, room)
     box = bpy.data.objects["Box"]
     photographed = box.matrix_world.copy()
     assert _relocate(*MOVE) == {'FINISHED'}

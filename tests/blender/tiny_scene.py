@@ -11,6 +11,7 @@ import numpy as np
 from tests.engine.tiny_room import (  # noqa: F401  (re-exported: the Blender tests use the room through this module)
     BOX,
     CENTER,
+    CRATE,
     LAMP_HALF,
     LAMP_Z,
     ROOM,
@@ -31,6 +32,17 @@ def mesh_object(bpy, name: str, vertices: list, faces: list):
     obj = bpy.data.objects.new(name, mesh)
     bpy.context.scene.collection.objects.link(obj)
     return obj
+
+
+def add_crate(bpy, hdri_path: str | Path):
+    """The CRATE as a mesh object, and the world's panorama (the image at `hdri_path`) rewritten
+    to show it: a proxy the photograph does not show is refused."""
+    crate = mesh_object(bpy, "Crate", *box_faces(*CRATE))
+    wanted = Path(hdri_path).resolve()
+    image = next(i for i in bpy.data.images if Path(bpy.path.abspath(i.filepath)).resolve() == wanted)
+    write_exr(hdri_path, synthetic_hdri(image.size[0], image.size[1], crate=True))
+    image.reload()
+    return crate
 
 
 def environment_world(bpy, name: str, image):

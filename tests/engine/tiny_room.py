@@ -23,6 +23,8 @@ if TYPE_CHECKING:
 CENTER = (0.0, 0.0, 1.2)
 ROOM = ((-2.0, -2.0, 0.0), (2.0, 2.0, 3.0))
 BOX = ((0.7, -0.3, 0.0), (1.3, 0.3, 0.6))
+# A second, smaller box some tests add to the room; the panorama shows it only when asked to.
+CRATE = ((-0.9, -0.8, 0.0), (-0.6, -0.5, 0.3))
 LAMP_HALF = 0.3
 LAMP_Z = ROOM[1][2] - 0.01
 
@@ -57,8 +59,9 @@ def _ray_box(origin: np.ndarray, d: np.ndarray, lo: tuple, hi: tuple) -> np.ndar
     return np.where((far >= np.maximum(near, 0.0)) & (near > 0.0), near, np.inf)
 
 
-def synthetic_hdri(width: int = 64, height: int = 32) -> np.ndarray:
-    """(H, W, 3) float32 radiance of the room seen from CENTER (Blender's equirectangular map)."""
+def synthetic_hdri(width: int = 64, height: int = 32, *, crate: bool = False) -> np.ndarray:
+    """(H, W, 3) float32 radiance of the room seen from CENTER (Blender's equirectangular map),
+    with the CRATE standing in it too when `crate` (its shadow left out)."""
     u = (np.arange(width) + 0.5) / width
     v = 1.0 - (np.arange(height) + 0.5) / height
     phi = (0.5 - u[None, :]) * 2.0 * np.pi
@@ -91,6 +94,8 @@ def synthetic_hdri(width: int = 64, height: int = 32) -> np.ndarray:
 
     box = _ray_box(c, d, *BOX) < t
     rgb[box] = (0.5, 0.06, 0.05)
+    if crate:
+        rgb[_ray_box(c, d, *CRATE) < t] = (0.12, 0.3, 0.5)
     return rgb
 
 

@@ -161,3 +161,20 @@ def test_relocation_region_and_ratio() -> None:
     assert M.relocation_error_ratio(inp, moved, moved, region) == pytest.approx(0.0)
     with pytest.raises(ValueError):
         M.relocation_error_ratio(inp, inp, moved, np.zeros_like(region))
+
+
+def test_ghost_share_counts_the_object_pixels_left_visibly_wrong() -> None:
+    rng = np.random.default_rng(3)
+    truth = (0.5 + 0.05 * rng.standard_normal((H, W, 3))).clip(0.1)
+    mask = np.zeros((H, W), bool)
+    mask[8:14, 10:18] = True
+    # A proxy 4 px off: the left half of the object is still there, dark, in the edit.
+    edit = truth.copy()
+    edit[8:14, 10:14] = 0.1
+    assert M.ghost_share(truth, truth, mask) == 0.0
+    # The blur spreads the ghost by a pixel, a third of its contrast: under the 30 % threshold.
+    assert M.ghost_share(edit, truth, mask) == pytest.approx(0.5)
+    assert M.ghost_share(100.0 * edit, 100.0 * truth, mask) == pytest.approx(0.5)
+    assert M.ghost_share(edit, truth, mask, threshold=0.9) == 0.0
+    with pytest.raises(ValueError):
+        M.ghost_share(edit, truth, np.zeros_like(mask))

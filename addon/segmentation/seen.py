@@ -1,0 +1,239 @@
+"""The object as the photograph shows it: the proxy's silhouette corrected by segmenting the
+panorama around it, with the artist's mask applied.
+
+A proxy placed by eye is a few centimetres, degrees and percent off. The region the removal
+fills is therefore decided by the image in a band around the proxy's silhouette; the proxy
+alone decides farther away. The window is segmented at the panorama's own resolution, or on
+an area-averaged copy when it would exceed `_MAX_PIXELS` (a close object in a 16K panorama).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import DimredError
+from ..geometry import latlong
+from ..geometry.mesh import Geometry
+from ..geometry.planeraster import Frame
+from ..geometry.raycast import trace_panorama
+from ..geometry.span import pixel_span
+from ..light.radiosity import LUMA
+from ..report import Report
+from .grabcut import ObjectSegmentation, segment_object
+from .masks import box_mean, dilate
+from .user_mask import UserMask
+
+_MAX_PIXELS = 1 << 20  # the largest window segmented at full resolution
+_COARSE_WIDTH = 512  # the panorama's width at which the window is first found
+_PAD = 2  # pixels the window reaches past the band
+_MIN_BAND = 3
+_SHADOW = 0.9  # an added pixel this much darker than the background around it, ...
+_SHADOW_CHROMA = 0.08  # ... its log chromaticity this close to the background's, is its shadow
+# A proxy whose silhouette and the segmented object share less than this is not over the object.
+_MIN_OVERLAP = 0.25
+_MIN_SEPARATION = 0.8  # below this the two sides' colours cannot be told apart ...
+_MIN_CONTRAST = 2.6  # ... and below this the outline follows no edge of the image
+
+
+@dataclass(frozen=True)
+class SeenObject:
+    """(h, w) maps over `frame`, a window of the panorama at the segmentation's resolution
+    (`factor` panorama pixels to a side of each of its pixels)."""
+
+    frame: Frame
+    factor: int
+    image: np.ndarray  # (h, w, 3) float32 radiance
+    proxy: np.ndarray  # bool: the proxy is the first hit
+    segmentation: ObjectSegmentation | None  # None where the image was not consulted
+    shown: np.ndarray  # bool: what the removal fills (before its one-pixel margin)
+    band: int  # half-width of the band the image decided, in pixels of `frame`
+
+    def in_frame(self, frame: Frame, shape: tuple[int, int]) -> np.ndarray:
+        """`shown` over an (h, w) window `frame` of the panorama at another resolution: a pixel
+        of a coarser one is shown where any shown pixel falls into it, of a finer one where the
+        shown pixel holding its centre is."""
+        out = np.zeros(shape, dtype=bool)
+        if frame.height < self.frame.height:
+            r, c = np.nonzero(self.shown)
+            scale = frame.height / self.frame.height
+            rows = ((self.frame.row0 + r + 0.5) * scale).astype(np.int64)
+            cols = ((np.mod(self.frame.col0 + c, self.frame.width) + 0.5) * scale).astype(np.int64)
+            wr, wc, inside = frame.locate(rows, np.mod(cols, frame.width), shape)
+            out[wr[inside], wc[inside]] = True
+            return out
+        scale = self.frame.height / frame.height
+        rows = ((frame.row0 + np.arange(shape[0]) + 0.5) * scale).astype(np.int64)
+        cols = ((np.mod(frame.col0 + np.arange(shape[1]), frame.width) + 0.5) * scale).astype(np.int64)
+        rr, cc = np.broadcast_arrays(rows[:, None], cols[None, :])
+        sr, sc, inside = self.frame.locate(rr, cc, self.shown.shape)
+        out[inside] = self.shown[sr[inside], sc[inside]]
+        return out
+
+    def whole(self, height: int, width: int) -> np.ndarray:
+        """(height, width) bool: `shown` over a whole panorama of that size."""
+        return self.in_frame(Frame(0, 0, height, width), (height, width))
+
+    def summary(self) -> dict[str, object]:
+        """What the report says of it (pixel counts at the segmentation's resolution)."""
+        proxy, shown = self.proxy, self.shown
+        union = int((proxy | shown).sum())
+        out: dict[str, object] = {
+            "window": [int(self.shown.shape[1]), int(self.shown.shape[0])],
+            "factor": self.factor,
+            "band_pixels": self.band,
+            "proxy_pixels": int(proxy.sum()),
+            "filled_pixels": int(shown.sum()),
+            "beyond_proxy": int((shown & ~proxy).sum()),
+            "proxy_not_object": 0,
+            "agreement": round(float((proxy & shown).sum() / union), 4) if union else 1.0,
+        }
+        seg = self.segmentation
+        if seg is not None:
+            out["proxy_not_object"] = int((proxy & ~seg.object).sum())
+            out["segmented_pixels"] = int(seg.object.sum())
+            out["outline_contrast"] = round(float(seg.outline_contrast), 3)
+            out["separation"] = round(float(seg.separation), 3)
+        return out
+
+
+def seen_object(hdri: np.ndarray, geo: Geometry, index: int, *, segment: bool = True, band: float = 0.12,
+                prior: float = 3.0, mask: UserMask | None = None, rep: Report | None = None) -> SeenObject | None:
+    """The object `index` of `geo` (probe frame) as the panorama `hdri` (H, W, 3) shows it; None
+    when no pixel sees it (nor does the user's mask add any). `band` is the half-width of
+    the band the image decides, as a share of the object's angular size, `prior` what a pixel
+    there must gain to leave the proxy's side (nats). DimredError when the proxy does not lie
+    over anything the photograph shows as an object there."""
+    height, width = hdri.shape[:2]
+    on = geo.tri_object == index
+    spot = _coarse_spot(geo.triangles[on], mask, width, height)
+    if spot is None:
+        return None
+    centre = geo.triangles[on].reshape(-1, 3)
+    mid = 0.5 * (centre.min(axis=0) + centre.max(axis=0))
+    radius = float(np.linalg.norm(centre - mid, axis=1).max())
+    distance = float(np.linalg.norm(mid))
+    angular = 2.0 * np.arcsin(min(1.0, radius / max(distance, 1e-12)))
+    band_full = max(_MIN_BAND, int(np.ceil(band * angular * height / np.pi)))
+    factor = _factor(spot, band_full, width, height)
+    hs, ws = height // factor, width // factor
+    band_px = max(_MIN_BAND, int(np.ceil(band_full / factor)))
+    frame, shape = _window(spot, band_px + _PAD, hs, ws)
+    window = (frame.row0, shape[0], frame.col0, shape[1])
+    obj = trace_panorama(geo.triangles[on], ws, hs, window=window)
+    others = trace_panorama(geo.triangles[~on], ws, hs, window=window)
+    proxy = (obj.tri >= 0) & ((others.tri < 0) | (obj.distance < others.distance))
+    image = _window_image(hdri, frame, shape, factor)
+    seg = None
+    name = geo.object_names[index]
+    if segment and proxy.any():
+        if float(image.max()) <= 0.0:
+            # A black panorama shows nothing to segment; its removal changes nothing either.
+            if rep is not None:
+                rep.warn(f"the panorama is black around '{name}': its proxy's silhouette is filled as modelled")
+        elif float(np.ptp(image)) <= 1e-6 * float(image.max()):
+            _refuse(name, 0.0)
+        else:
+            seg = segment_object(image, proxy, band=band_px, prior=prior)
+            _check_overlap(seg, proxy, name)
+    shown = proxy | _added(image, proxy, seg, band_px) if seg is not None else proxy.copy()
+    if mask is not None:
+        add, take = mask.in_frame(frame, shape)
+        shown = (shown | add) & ~take
+    seen = SeenObject(frame=frame, factor=factor, image=image, proxy=proxy, segmentation=seg, shown=shown,
+                      band=band_px)
+    if rep is not None:
+        rep.info["segmentation"] = seen.summary()
+    return seen
+
+
+def _coarse_spot(tris: np.ndarray, mask: UserMask | None, width: int, height: int) -> np.ndarray | None:
+    """(hc, wc) bool: where the object (its raster and its vertices, so no sliver is missed)
+    and the user's added pixels are at a coarse resolution; None when nowhere."""
+    wc = min(width, _COARSE_WIDTH)
+    hc = wc // 2
+    spot = trace_panorama(tris, wc, hc).tri >= 0
+    spot[latlong.uv_to_pixel(*latlong.direction_to_uv(tris.reshape(-1, 3)), wc, hc)] = True
+    if mask is not None and mask.add.any():
+        spot |= mask.in_frame(Frame(0, 0, hc, wc), (hc, wc))[0] | _scattered(mask.add, hc, wc)
+    return spot if spot.any() else None
+
+
+def _scattered(mask: np.ndarray, height: int, width: int) -> np.ndarray:
+    """(height, width) bool: any pixel of a finer whole-panorama `mask` falls into it."""
+    out = np.zeros((height, width), dtype=bool)
+    r, c = np.nonzero(mask)
+    out[(r * height) // mask.shape[0], (c * width) // mask.shape[1]] = True
+    return out
+
+
+def _factor(spot: np.ndarray, band: int, width: int, height: int) -> int:
+    """Panorama pixels per segmentation pixel: 1 unless the window would be too large (then a
+    power of two that divides the panorama's size)."""
+    r0, r1, _, cols = pixel_span(spot, 1)
+    scale = height / spot.shape[0]
+    pixels = (r1 - r0) * scale + 2 * band
+    pixels *= cols * scale + 2 * band
+    factor = 1
+    while pixels / factor**2 > _MAX_PIXELS and width % (2 * factor) == 0 and height % (2 * factor) == 0:
+        factor *= 2
+    return factor
+
+
+def _window(spot: np.ndarray, pad: int, height: int, width: int) -> tuple[Frame, tuple[int, int]]:
+    """The window of a (height, width) panorama holding the coarse `spot` and `pad` pixels more."""
+    r0, r1, c0, cols = pixel_span(spot, 1)
+    scale = height / spot.shape[0]
+    row0 = max(0, int(np.floor(r0 * scale)) - pad)
+    row1 = min(height, int(np.ceil(r1 * scale)) + pad)
+    ncols = int(np.ceil(cols * scale)) + 2 * pad
+    if ncols >= width:
+        return Frame(row0, 0, height, width), (row1 - row0, width)
+    return Frame(row0, (int(np.floor(c0 * scale)) - pad) % width, height, width), (row1 - row0, ncols)
+
+
+def _window_image(hdri: np.ndarray, frame: Frame, shape: tuple[int, int], factor: int) -> np.ndarray:
+    """(h, w, 3) float32 radiance of the window, area-averaged over `factor` x `factor` pixels."""
+    width = hdri.shape[1]
+    cols = np.mod((frame.col0 * factor + np.arange(shape[1] * factor)), width)
+    out = np.empty((*shape, 3), dtype=np.float32)
+    band = max(1, (1 << 22) // (len(cols) * factor))
+    for start in range(0, shape[0], band):
+        stop = min(start + band, shape[0])
+        rows = hdri[(frame.row0 + start) * factor:(frame.row0 + stop) * factor][:, cols]
+        rows = np.maximum(rows.astype(np.float32), 0.0)
+        out[start:stop] = rows.reshape(stop - start, factor, shape[1], factor, 3).mean(axis=(1, 3))
+    return out
+
+
+def _added(image: np.ndarray, proxy: np.ndarray, seg: ObjectSegmentation, band: int) -> np.ndarray:
+    """The pixels the segmentation adds to the proxy's silhouette, less those a shadow on the
+    background explains: darker than the background around them by `_SHADOW` or more, in its
+    colour. The object's own contact shadow lies along its outline and looks like a dark face
+    of it; left in, the fill would put lit floor where the photograph's shadow is."""
+    added = seg.object & ~proxy
+    if not added.any():
+        return added
+    rgb = np.maximum(image.astype(np.float64), 0.0) + 1e-6 * max(float(image.mean()), 1e-30)
+    y = rgb @ LUMA
+    chroma = np.log(rgb[..., [0, 2]] / rgb[..., 1:2])
+    around = ~seg.object & ~proxy & dilate(proxy, 2 * band)
+    features = np.concatenate([np.log(y)[..., None], chroma], axis=2)
+    local, weight = box_mean(features, around, 2 * band)
+    darker = np.log(y) < local[..., 0] + np.log(_SHADOW)
+    alike = np.abs(chroma - local[..., 1:]).max(axis=2) < _SHADOW_CHROMA
+    return added & ~(darker & alike & (weight > 0))
+
+
+def _check_overlap(seg: ObjectSegmentation, proxy: np.ndarray, name: str) -> None:
+    shared = float((seg.object & proxy).sum()) / max(1, int(proxy.sum()))
+    unclear = seg.separation < _MIN_SEPARATION and seg.outline_contrast < _MIN_CONTRAST
+    if shared < _MIN_OVERLAP or unclear:
+        _refuse(name, shared)
+
+
+def _refuse(name: str, shared: float) -> None:
+    raise DimredError(
+        f"the proxy '{name}' does not lie over what the photograph shows there ({shared:.0%} of its silhouette "
+        "looks like an object): check that the right object is marked and that it stands where the "
+        "panorama shows it")
