@@ -69,7 +69,7 @@ def _run(scene: SceneData, quality: str, overrides: dict, compute: Callable[[Sce
     if alignment is not None:
         report["alignment"] = alignment.summary()
         report["seconds"] = {**report["seconds"], "alignment": round(alignment.seconds, 4)}
-        if not alignment.applied:
+        if not alignment.applied and not alignment.fits:
             report["warnings"] = [*report["warnings"], alignment.message]
     return replace(result, hdri=original, report=report)
 

@@ -82,7 +82,7 @@ class DIMRED_OT_align(bpy.types.Operator):
             pictures.show_diagnostics(picture)
         settings.photo_fit = session.photo_fit(obj.name, seen.summary() if seen else None, alignment.summary())
         if not alignment.applied:
-            self.report({'WARNING'}, alignment.message)
+            self.report({'INFO'} if alignment.fits else {'WARNING'}, alignment.message)
             return {'CANCELLED'}
         correction = Matrix(alignment.matrix.tolist())
         obj.matrix_world = correction @ obj.matrix_world

@@ -34,10 +34,7 @@ _SPACING = 0.5  # silhouette samples per pixel of outline
 _FINEST = 1.5  # pixels: the robust scale the fit ends at ...
 _SHRINK = 0.6  # ... shrinking by this factor a step
 _MAX_STEPS = 40
-# The outline fitted to is the image's alone: a prior towards the proxy's side would hold it
-# where the proxy is wherever the colours are alike (a crate against a wall of its colour);
-# what it takes in wrongly instead (a shadow, a floor tile) the robust weights leave out.
-_PRIOR = 3.0
+_GAIN = 0.25  # the share of the modelled pose's robust cost a correction must save to be applied
 # A centimetre of shift or height, a degree of turn, a percent of scale ...
 _UNITS = np.array([0.01, 0.01, 0.01, np.radians(1.0), 0.01])
 _UNSEEN = 0.02  # ... that moves the outline by less than this many pixels is left as modelled
@@ -58,7 +55,8 @@ class Alignment:
 
     pose: Pose
     pivot: np.ndarray  # (3,) world bottom centre it turns and scales about
-    applied: bool  # the fit converged to a plausible pose (else the proxy stays where it was)
+    applied: bool  # the fit converged to a plausible, clearly better pose (else the proxy stays where it was)
+    fits: bool  # it converged, but no pose fits the outline clearly better than the modelled one
     iterations: int
     before_px: float  # median distance of the silhouette from the outline, pixels, before ...
     after_px: float  # ... and after
@@ -85,6 +83,7 @@ class Alignment:
         """What report.json says of it."""
         return {
             "applied": self.applied,
+            "fits_as_modelled": self.fits,
             "message": self.message,
             "fitted": list(self.fitted),
             "shift_cm": [round(float(v) * 100.0, 3) for v in self.pose.shift],
@@ -123,7 +122,7 @@ def align_object(scene: SceneData, object_name: str, *, params: Params, fit_heig
     geo = build_geometry(scene.triangles, scene.tri_object, scene.object_names, scene.center, scene.rotation)
     if not (geo.tri_object == index).any():
         raise DimredError(f"'{object_name}' has no faces to align")
-    seen = seen_object(scene.hdri, geo, index, band=params.segmentation_band, prior=_PRIOR)
+    seen = seen_object(scene.hdri, geo, index, band=params.segmentation_band)
     if seen is None or not seen.proxy.any():
         raise DimredError(f"'{object_name}' is not visible from the probe centre: there is no outline to align to")
     if seen.segmentation is None:
@@ -169,11 +168,20 @@ def align_object(scene: SceneData, object_name: str, *, params: Params, fit_heig
     size = float(np.ptp(world.reshape(-1, 3), axis=0).max())
     plausible = (np.linalg.norm(pose.shift) <= _MAX_SHIFT * size and abs(pose.turn) <= _MAX_TURN
                  and 1.0 / _MAX_SCALE <= pose.scale <= _MAX_SCALE)
-    applied = converged and plausible
+    # A correction the outline hardly prefers to the modelled pose is not one: where the image
+    # barely tells the object from its background (a crate against a wall of its colour) the fit
+    # wanders to what the segmentation got wrong.
+    modelled = problem.fit(Pose.identity(), scale).cost
+    better = fit.cost <= (1.0 - _GAIN) * modelled
+    applied = converged and plausible and better
+    fits = converged and plausible and not better
     if applied:
         message = (f"aligned '{object_name}': moved {np.linalg.norm(pose.shift) * 100:.1f} cm, turned "
                    f"{np.degrees(pose.turn):.2f} deg, scaled {(pose.scale - 1) * 100:+.2f} %; outline within "
                    f"{after:.2f} px (was {before:.2f})")
+    elif fits:
+        message = (f"'{object_name}' already fits its outline in the panorama as well as any pose the outline "
+                   f"tells (within {before:.2f} px); the proxy is left as modelled")
     elif not converged:
         message = f"alignment of '{object_name}' did not converge in {steps} steps; the proxy is left where it was"
     else:
@@ -182,7 +190,7 @@ def align_object(scene: SceneData, object_name: str, *, params: Params, fit_heig
                    f"{(pose.scale - 1) * 100:+.0f} %); the proxy is left where it was")
     if applied and unseen:
         message += f" ({', '.join(_NAMES[k] for k in unseen)}: not told by the outline, left as modelled)"
-    return Alignment(pose=pose if applied else Pose.identity(), pivot=problem.pivot, applied=applied,
+    return Alignment(pose=pose if applied else Pose.identity(), pivot=problem.pivot, applied=applied, fits=fits,
                      iterations=steps, before_px=before, after_px=after if applied else before,
                      points=len(fit.points), fitted=tuple(_NAMES[k] for k in problem.columns if k not in unseen),
                      message=message, seconds=time.perf_counter() - started)

@@ -141,22 +141,11 @@ def build_parser(*, blend_already_loaded: bool) -> argparse.ArgumentParser:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     commands = parser.add_subparsers(title="commands", dest="command", required=True, metavar="COMMAND")
-    remove = commands.add_parser(
-        "remove",
-        help="remove an object from the panorama",
-        description=_DESCRIPTION,
-        epilog=_EPILOG,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-    )
+    remove = _command(commands, "remove", "remove an object from the panorama", _DESCRIPTION)
     _scene_arguments(remove, blend_already_loaded, "the mesh object to remove")
     remove.set_defaults(run=_remove)
-    relocate = commands.add_parser(
-        "relocate",
-        help="move an object elsewhere in the panorama (fixed-view constraint)",
-        description=_RELOCATE_DESCRIPTION,
-        epilog=_EPILOG,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-    )
+    relocate = _command(commands, "relocate", "move an object elsewhere in the panorama (fixed-view constraint)",
+                        _RELOCATE_DESCRIPTION)
     _scene_arguments(relocate, blend_already_loaded, "the mesh object to move")
     relocate.add_argument("--yaw", type=float, default=0.0, metavar="DEG",
                           help="degrees to turn the object about the vertical axis through the probe centre "
@@ -164,17 +153,18 @@ def build_parser(*, blend_already_loaded: bool) -> argparse.ArgumentParser:
     relocate.add_argument("--distance-scale", type=float, default=1.0, metavar="S",
                           help="factor on the object's horizontal distance from that axis (> 0; default 1)")
     relocate.set_defaults(run=_relocate)
-    align = commands.add_parser(
-        "align",
-        help="fit the proxy's pose to the object's outline in the panorama (Align to Photo)",
-        description=_ALIGN_DESCRIPTION,
-        epilog=_EPILOG,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-    )
+    align = _command(commands, "align", "fit the proxy's pose to the object's outline in the panorama (Align to Photo)",
+                     _ALIGN_DESCRIPTION)
     _scene_arguments(align, blend_already_loaded, "the mesh object to align", removal=False)
     align.add_argument("--save", metavar="COPY.blend", help="write a copy of the .blend with the corrected object")
     align.set_defaults(run=_align)
     return parser
+
+
+def _command(commands: argparse._SubParsersAction, name: str, summary: str, description: str
+             ) -> argparse.ArgumentParser:
+    return commands.add_parser(name, help=summary, description=description, epilog=_EPILOG,
+                               formatter_class=argparse.RawDescriptionHelpFormatter)
 
 
 def _scene_arguments(parser: argparse.ArgumentParser, blend_already_loaded: bool, object_help: str, *,
@@ -253,7 +243,7 @@ def _align(args: argparse.Namespace) -> int:
     _write_files(out, {"report.json": _json_writer(report)}
                  | ({} if picture is None else {"diagnostics.png": lambda path: write_png(path, picture)}),
                  stale=("diagnostics.png",))
-    if not alignment.applied:
+    if not alignment.applied and not alignment.fits:
         print(f"{PROG}: {alignment.message}", file=sys.stderr, flush=True)
         return 1
     if save:

@@ -98,12 +98,11 @@ class SeenObject:
 
 
 def seen_object(hdri: np.ndarray, geo: Geometry, index: int, *, segment: bool = True, band: float = 0.12,
-                prior: float = 3.0, mask: UserMask | None = None, rep: Report | None = None) -> SeenObject | None:
+                mask: UserMask | None = None, rep: Report | None = None) -> SeenObject | None:
     """The object `index` of `geo` (probe frame) as the panorama `hdri` (H, W, 3) shows it; None
     when no pixel sees it (nor does the user's mask add any). `band` is the half-width of
-    the band the image decides, as a share of the object's angular size, `prior` what a pixel
-    there must gain to leave the proxy's side (nats). DimredError when the proxy does not lie
-    over anything the photograph shows as an object there."""
+    the band the image decides, as a share of the object's angular size. DimredError when the
+    proxy does not lie over anything the photograph shows as an object there."""
     height, width = hdri.shape[:2]
     on = geo.tri_object == index
     spot = _coarse_spot(geo.triangles[on], mask, width, height)
@@ -134,7 +133,7 @@ def seen_object(hdri: np.ndarray, geo: Geometry, index: int, *, segment: bool = 
         elif float(np.ptp(image)) <= 1e-6 * float(image.max()):
             _refuse(name, 0.0)
         else:
-            seg = segment_object(image, proxy, band=band_px, prior=prior)
+            seg = segment_object(image, proxy, band=band_px)
             _check_overlap(seg, proxy, name)
     shown = proxy | _added(image, proxy, seg, band_px) if seg is not None else proxy.copy()
     if mask is not None:

@@ -61,7 +61,7 @@ def test_a_misplaced_proxy_is_brought_back_to_the_photographed_pose(scene, error
 
 def test_an_exact_proxy_stays_where_it_is(scene):
     alignment = align_object(scene, "Box", params=PARAMS)
-    assert alignment.applied
+    assert alignment.applied or alignment.fits, alignment.message
     box = scene.triangles[scene.tri_object == scene.object_index("Box")]
     shift, turn, scale = _residual(alignment, np.eye(4), bottom_centre(box))
     assert shift <= 0.5 and turn <= 0.5 and scale <= 0.5
