@@ -21,14 +21,14 @@ from ..geometry.span import pixel_span
 from ..light.radiosity import LUMA
 from ..report import Report
 from .grabcut import ObjectSegmentation, segment_object
-from .masks import box_mean, dilate
+from .masks import blur, box_mean, dilate
 from .user_mask import UserMask
 
 _MAX_PIXELS = 1 << 20  # the largest window segmented at full resolution
 _COARSE_WIDTH = 512  # the panorama's width at which the window is first found
 _PAD = 2  # pixels the window reaches past the band
 _MIN_BAND = 3
-_SHADOW = 0.9  # an added pixel this much darker than the background around it, ...
+_SHADOW = 0.9  # an added pixel this much darker than the brightest background around it, ...
 _SHADOW_CHROMA = 0.08  # ... its log chromaticity this close to the background's, is its shadow
 # A proxy whose silhouette and the segmented object share less than this is not over the object.
 _MIN_OVERLAP = 0.25
@@ -207,20 +207,22 @@ def _window_image(hdri: np.ndarray, frame: Frame, shape: tuple[int, int], factor
 
 def _added(image: np.ndarray, proxy: np.ndarray, seg: ObjectSegmentation, band: int) -> np.ndarray:
     """The pixels the segmentation adds to the proxy's silhouette, less those a shadow on the
-    background explains: darker than the background around them by `_SHADOW` or more, in its
-    colour. The object's own contact shadow lies along its outline and looks like a dark face
-    of it; left in, the fill would put lit floor where the photograph's shadow is."""
+    background explains: darker by `_SHADOW` or more than the background around them (its mean
+    log luminance within two bands), in the background's colour. The object's own contact
+    shadow lies along its outline and looks like a dark face of it; left in, the fill would put
+    lit floor where the photograph's shadow is."""
     added = seg.object & ~proxy
     if not added.any():
         return added
-    rgb = np.maximum(image.astype(np.float64), 0.0) + 1e-6 * max(float(image.mean()), 1e-30)
-    y = rgb @ LUMA
+    # Smoothed twice: a render's or a sensor's noise would make every pixel's colour its own.
+    rgb = blur(blur(np.maximum(image, 0.0))).astype(np.float64) + 1e-6 * max(float(image.mean()), 1e-30)
+    log_y = np.log(rgb @ LUMA)
     chroma = np.log(rgb[..., [0, 2]] / rgb[..., 1:2])
     around = ~seg.object & ~proxy & dilate(proxy, 2 * band)
-    features = np.concatenate([np.log(y)[..., None], chroma], axis=2)
-    local, weight = box_mean(features, around, 2 * band)
-    darker = np.log(y) < local[..., 0] + np.log(_SHADOW)
-    alike = np.abs(chroma - local[..., 1:]).max(axis=2) < _SHADOW_CHROMA
+    local, weight = box_mean(np.concatenate([log_y[..., None], chroma], axis=2), around, 2 * band)
+    local_chroma = local[..., 1:]
+    darker = log_y < local[..., 0] + np.log(_SHADOW)
+    alike = np.abs(chroma - local_chroma).max(axis=2) < _SHADOW_CHROMA
     return added & ~(darker & alike & (weight > 0))
 
 
