@@ -123,10 +123,9 @@ def align_to_photo(scene: SceneData, object_name: str, *, quality: str = DEFAULT
                    **overrides: object) -> Alignment:
     """Fit `object_name`'s pose on its support to its outline in the panorama (Align to Photo)."""
     validate(scene)
-    params = params_for(quality, **overrides)
-    if negative_pixels(scene.hdri):
-        scene = replace(scene, hdri=clamped_rows(scene.hdri, 0, scene.hdri.shape[0]))
-    return align_object(scene, object_name, params=params, fit_height=fit_height)
+    # The fit reads the panorama only in the object's window, clamping negative radiance there
+    # (`segmentation.seen`): no clamped copy of the whole panorama is made.
+    return align_object(scene, object_name, params=params_for(quality, **overrides), fit_height=fit_height)
 
 
 def photographed_object(scene: SceneData, object_name: str, *, quality: str = DEFAULT_QUALITY,
