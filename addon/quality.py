@@ -38,6 +38,9 @@ class Params:
     synth_neighbourhood: int = 7  # synthesis window (odd): larger follows larger structures, slower
     synth_levels: int = 0  # pyramid levels of the synthesis, 0 = from the hole's size
     synth_generations: int = 2  # synthesis passes per level: more settle seams, slower
+    # compose tiled and planked floors from shifted copies of the visible floor first, so that
+    # their lines run on through the hole; False leaves all to the per-pixel synthesis
+    synth_structure: bool = True
     seed: int = 0  # the synthesis's random seed: the same seed gives the same fill
     # the light is solved on a copy of the panorama at most this wide; the full-resolution
     # panorama takes it from there (upsampled, refined where it is sharp, filled at its own size)

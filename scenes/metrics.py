@@ -35,10 +35,34 @@ def luminance(rgb: np.ndarray) -> np.ndarray:
 
 def box_blur3(a: np.ndarray) -> np.ndarray:
     """3x3 mean over the first two axes: wraps around the u seam (axis 1), clamps at the poles."""
+    return box_blur(a, 1)
+
+
+def box_blur(a: np.ndarray, radius: int) -> np.ndarray:
+    """(2 radius + 1)^2 mean over the first two axes: wraps around the u seam (axis 1), clamps at
+    the poles."""
     a = np.asarray(a, dtype=np.float64)
-    v = np.concatenate([a[:1], a, a[-1:]], axis=0)
-    v = (v[:-2] + v[1:-1] + v[2:]) / 3.0
-    return (np.roll(v, 1, axis=1) + v + np.roll(v, -1, axis=1)) / 3.0
+    n = 2 * radius + 1
+    v = np.concatenate([a[:1].repeat(radius, axis=0), a, a[-1:].repeat(radius, axis=0)], axis=0)
+    c = np.cumsum(np.concatenate([np.zeros_like(v[:1]), v]), axis=0)
+    v = (c[n:] - c[:-n]) / n
+    return sum(np.roll(v, k, axis=1) for k in range(-radius, radius + 1)) / n
+
+
+def band_pass(y: np.ndarray) -> np.ndarray:
+    """Edges and lines a pixel or a few wide: box blur of radius 1 minus box blur of radius 4.
+    Render noise is mostly below it, shading and plank colours mostly above."""
+    return box_blur(y, 1) - box_blur(y, 4)
+
+
+def structure_correlation(edit: np.ndarray, truth: np.ndarray, mask: np.ndarray) -> float:
+    """Correlation over `mask` of the band-pass luminance of `edit` with the truth's: 1 where the
+    fill's edges and lines run where they really do, 0 for a flat fill or lines out of phase
+    (MAE rewards blur and a detail ratio any texture; this rewards only lines in place)."""
+    a = band_pass(luminance(edit))[mask]
+    b = band_pass(luminance(truth))[mask]
+    a, b = a - a.mean(), b - b.mean()
+    return float((a * b).sum() / max(np.sqrt((a * a).sum() * (b * b).sum()), 1e-30))
 
 
 def _blurred_y(rgb: np.ndarray) -> np.ndarray:
@@ -168,7 +192,9 @@ def hidden_region_scores(input: np.ndarray, edit: np.ndarray, truth: np.ndarray,
     - `detail_ratio`: standard deviation of the high-pass Y - box_blur3(Y) over those pixels,
       edit / truth (1 = as much texture; a flat fill gives ~0, noise explosions > 1);
     - `object_shadow_ratio`: the blurred-Y error sum over the object's pixels and region A
-      together, edit / input (how much of the removal's whole error is left)."""
+      together, edit / input (how much of the removal's whole error is left);
+    - `structure`: `structure_correlation` over the object's pixels (tile and plank lines in
+      phase with the truth's)."""
     y_in, y_ed, y_tr = luminance(input), luminance(edit), luminance(truth)
 
     def high_pass(y: np.ndarray) -> np.ndarray:
@@ -180,6 +206,7 @@ def hidden_region_scores(input: np.ndarray, edit: np.ndarray, truth: np.ndarray,
         "mean_ratio": float(y_ed[object_mask].mean() / y_tr[object_mask].mean()),
         "detail_ratio": float(high_pass(y_ed).std() / max(high_pass(y_tr).std(), 1e-30)),
         "object_shadow_ratio": float(np.abs(be - bt)[region].sum() / np.abs(bi - bt)[region].sum()),
+        "structure": structure_correlation(edit, truth, object_mask),
     }
 
 

@@ -150,14 +150,20 @@ def sample_panorama(raster: PlaneRaster, image: np.ndarray, valid: np.ndarray, *
     """Bilinear lookup of panorama pixels (h, w, C) covering `frame` (default: the whole
     panorama) at the cells, from `valid` pixels only: (h, w, C) values and (h, w) the weight
     the valid pixels had (0 where none)."""
+    return sample_points(raster.points(), image, valid, frame=frame)
+
+
+def sample_points(points: np.ndarray, image: np.ndarray, valid: np.ndarray, *, frame: Frame | None = None
+                  ) -> tuple[np.ndarray, np.ndarray]:
+    """`sample_panorama` at any points (..., 3) in the probe frame: (..., C) and (...)."""
     frame = frame or Frame.whole(image.shape)
-    u, v = latlong.direction_to_uv(raster.points())
+    u, v = latlong.direction_to_uv(points)
     x = u * frame.width - 0.5
     y = np.clip((1.0 - v) * frame.height - 0.5, 0.0, frame.height - 1.0)  # clamped at the poles
     x0, y0 = np.floor(x), np.floor(y)
     fx, fy = x - x0, y - y0
-    total = np.zeros((*raster.shape, image.shape[2]))
-    weight = np.zeros(raster.shape)
+    total = np.zeros((*u.shape, image.shape[2]))
+    weight = np.zeros(u.shape)
     for dy, wy in ((0, 1.0 - fy), (1, fy)):
         for dx, wx in ((0, 1.0 - fx), (1, fx)):
             rows = np.minimum(y0.astype(np.int64) + dy, frame.height - 1)

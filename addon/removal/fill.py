@@ -2,6 +2,7 @@
 reflectance around the hole, lit by the irradiance after the removal (L' = rho E' / pi)."""
 from __future__ import annotations
 
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -63,7 +64,7 @@ def fill_hidden(solution: Solution, revealed: Revealed, rep: Report, callbacks: 
                           synthesis=SynthesisParams(neighbourhood=solution.params.synth_neighbourhood,
                                                     levels=solution.params.synth_levels,
                                                     generations=solution.params.synth_generations),
-                          seed=solution.params.seed)
+                          seed=solution.params.seed, structure=solution.params.synth_structure)
     surfaces = []
     for sel, plane in hidden_planes(geo, solution.target.surface_key, revealed.tri, revealed.points):
         callbacks.check()
@@ -72,8 +73,10 @@ def fill_hidden(solution: Solution, revealed: Revealed, rep: Report, callbacks: 
             rho[sel] = level_rho
             show(change())
 
+        t0 = time.perf_counter()
         got = fill_surface(revealed.panorama, plane, options, cancel=callbacks.cancel,
                            progress=None if show is None else level_shown)
+        seconds = time.perf_counter() - t0
         name = geo.object_names[geo.tri_object[revealed.tri[sel[0]]]]
         if got.known_cells:
             rho[sel] = got.rho
@@ -82,7 +85,8 @@ def fill_hidden(solution: Solution, revealed: Revealed, rep: Report, callbacks: 
                      f"{len(sel)} pixels get its mean reflectance")
         surfaces.append({"surface": name, "pixels": len(sel), "raster": list(got.raster_shape),
                          "cell": round(got.cell, 5), "known_cells": got.known_cells, "hole_cells": got.hole_cells,
-                         "synthesised": got.synthesised})
+                         "synthesised": got.synthesised, "structured_cells": got.structured,
+                         "seconds": round(seconds, 4)})
     rep.info["filled_surfaces"] = surfaces
     return change()
 

@@ -15,6 +15,7 @@ import numpy as np
 
 from ..errors import DimredError
 from ..geometry import planeraster
+from .structure import StructureFill, structure_fill
 from .texture import SynthesisParams, fill
 
 _MAX_CELLS = 512 * 512  # bounds the raster (and the exemplar) whatever the panorama size
@@ -66,6 +67,7 @@ class FillOptions:
     margin: float
     synthesis: SynthesisParams
     seed: int = 0
+    structure: bool = True  # compose tiled and planked floors from shifted copies first (`structure`)
 
 
 @dataclass(frozen=True)
@@ -76,6 +78,7 @@ class SurfaceFill:
     known_cells: int
     hole_cells: int
     synthesised: bool  # False: too little of the surface is seen; its mean reflectance is used
+    structured: int = 0  # hole cells composed from shifted copies (the rest: order-independent synthesis)
 
 
 def fill_surface(
@@ -111,15 +114,61 @@ def fill_surface(
     hole &= ~known
     mean = values[known].mean(axis=0) if known.any() else np.zeros(3)
     image = np.where(known[..., None], values, mean)
-    synthesised = False
+    synthesised, structure = False, None
     if known.sum() >= _MIN_KNOWN:
+        if options.structure:
+            structure = structure_fill(image, known, hole, footprint=_footprint(raster), seed=options.seed)
+        rest = hole if structure is None else hole & ~structure.covered
+        if structure is not None:
+            image = structure.image
+            if progress is not None and rest.any():
+                progress(planeraster.sample_raster(raster, image, points))
         on_level = None if progress is None else (
             lambda _level, preview: progress(planeraster.sample_raster(raster, preview, points)))
         try:
-            image = fill(image, known, hole, options.synthesis, seed=options.seed, progress=on_level, cancel=cancel)
+            if rest.any():
+                image = fill(image, known | hole & ~rest, rest, options.synthesis, seed=options.seed,
+                             progress=on_level, cancel=cancel)
             synthesised = True
         except DimredError:
             pass  # too little exemplar: the mean below is the honest fallback, reported by the caller
     rho = planeraster.sample_raster(raster, image, points)
+    if structure is not None:
+        rho = _copied(rho, panorama, plane, raster, structure)
     return SurfaceFill(rho=rho, raster_shape=raster.shape, cell=raster.cell, known_cells=int(known.sum()),
-                       hole_cells=int(hole.sum()), synthesised=synthesised)
+                       hole_cells=int(hole.sum()), synthesised=synthesised,
+                       structured=0 if structure is None else int(structure.covered.sum()))
+
+
+def _footprint(raster: planeraster.PlaneRaster) -> np.ndarray:
+    """(h, w) how coarsely the lat-long panorama resolves each cell, up to a constant: the edge
+    of a pixel (solid angle ~ cos latitude) projected at the cell's distance onto the plane."""
+    pts = raster.points()
+    dist = np.maximum(np.linalg.norm(pts, axis=-1), 1e-9)
+    cos_lat = np.hypot(pts[..., 0], pts[..., 1]) / dist
+    cos_incidence = np.abs(pts @ np.cross(raster.u, raster.v)) / dist
+    return dist * np.sqrt(np.maximum(cos_lat, 1e-3) / np.maximum(cos_incidence, 1e-3))
+
+
+def _copied(rho: np.ndarray, panorama: PanoramaReflectance, plane: HiddenPlane, raster: planeraster.PlaneRaster,
+            structure: StructureFill) -> np.ndarray:
+    """The hidden points whose cell the shift map composed read their copy from the panorama
+    itself, at the point moved by the cell's shift, plus the blend's smooth correction: one
+    resampling of the photograph instead of two (panorama to raster to panorama), which kept
+    half the detail."""
+    maps = panorama.maps
+    r, c = (np.clip(np.rint(x).astype(np.int64), 0, n - 1) for x, n in zip(raster.coords(plane.points), raster.shape,
+                                                                            strict=True))
+    label = structure.shifts.labels[r, c]
+    sel = np.flatnonzero(label >= 0)
+    if not len(sel):
+        return rho
+    t = structure.shifts.shifts[label[sel]] * raster.cell
+    source = plane.points[sel] + t[:, :1] * raster.v + t[:, 1:] * raster.u
+    copy, weight = planeraster.sample_points(source, panorama.rho,
+                                             panorama.valid & (maps.surface_with == plane.surface), frame=maps.frame)
+    correction = planeraster.sample_raster(raster, structure.correction, plane.points[sel])
+    ok = weight > 0.5
+    out = rho.copy()
+    out[sel[ok]] = copy[ok] + correction[ok]
+    return out

@@ -225,7 +225,7 @@ class OrderIndependentSynthesis:
                 # the membrane takes each border value as it is: outliers (border pixels whose
                 # reflectance is off where the irradiance estimate is poor, as in a contact shadow)
                 # would be carried into the hole, so they are clipped first
-                field = _harmonic(_robust(values, fixed), fixed, self._hole[l])
+                field = membrane(clip_outliers(values, fixed), fixed, self._hole[l])
             self._seams[l] = np.where(self._hole[l][..., None], field, 0).astype(np.float32)
         return self._seams[l]
 
@@ -670,7 +670,7 @@ def _refine_offsets(offsets: np.ndarray, image: np.ndarray, ring: np.ndarray, ex
     return offsets + steps[step], score[np.arange(len(offsets)), step]
 
 
-def _harmonic(values: np.ndarray, fixed: np.ndarray, region: np.ndarray) -> np.ndarray:
+def membrane(values: np.ndarray, fixed: np.ndarray, region: np.ndarray) -> np.ndarray:
     """`values` (H, W, C) interpolated over `region` from the pixels `fixed` around it: the
     membrane (discrete Laplace equation over 4-neighbours) that takes the fixed values at the
     region's border; neighbours neither fixed nor in the region carry no flux. Unlike a pull-push
@@ -716,7 +716,7 @@ def _neighbour(a: np.ndarray, d: tuple[int, int]) -> np.ndarray:
     return pad[1 + d[0]:1 + d[0] + h, 1 + d[1]:1 + d[1] + w]
 
 
-def _robust(values: np.ndarray, fixed: np.ndarray) -> np.ndarray:
+def clip_outliers(values: np.ndarray, fixed: np.ndarray) -> np.ndarray:
     """`values` clipped, channel by channel, to the median of the `fixed` ones +- _OUTLIER robust
     standard deviations (1.4826 x the median absolute deviation)."""
     if not fixed.any():

@@ -1,0 +1,82 @@
+"""Structure first: a hole on a tiled or planked plane composed from shifted copies of the
+visible floor, so that its lines run on in phase, with the seam at the hole's border blended.
+
+The texture's own repeats (`translations`) and shifts along the floor's axes are the labels of
+a shift map (`shift_map`); the step left between the copies and the known pixels along the
+border is taken to zero by a membrane over the hole (the gradient-domain blend of Poisson
+image editing, whose guidance field is the copies' own gradients), which also keeps the fill's
+mean on its surroundings where the copies came from darker or lighter tiles. A stochastic
+texture (carpet, concrete) has no dominant translation and matches itself along no axis:
+`structure_fill` returns None and the order-independent synthesis fills it alone.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .shift_map import ShiftMap, candidate_shifts, shift_map
+from .texture import clip_outliers, membrane
+from .translations import DOMINANT, Translations, dominant_translations, relative_difference
+
+_TRANSLATIONS = 8  # of the texture's repeats, the best this many are labels (time grows with labels^2)
+_STEPS = ((0, 1), (1, 0), (0, -1), (-1, 0))
+
+
+@dataclass(frozen=True)
+class StructureFill:
+    """`image` with the covered hole pixels composed and blended; `correction` (H, W, C) is the
+    smooth field the blend added there (0 elsewhere), `shifts` the shift map behind it."""
+
+    image: np.ndarray
+    correction: np.ndarray
+    shifts: ShiftMap
+    translations: Translations
+
+    @property
+    def covered(self) -> np.ndarray:
+        return self.shifts.covered
+
+
+def structure_fill(image: np.ndarray, known: np.ndarray, hole: np.ndarray, *, footprint: np.ndarray | None = None,
+                   seed: int = 0) -> StructureFill | None:
+    """The `hole` of `image` (H, W, C) composed from shifted copies of its `known` pixels, or
+    None where the texture has no dominant translation or no copy reaches the hole. `seed`
+    varies the axis shifts' lengths: another seed gives another, equally continuous fill
+    where the texture allows more than one (a periodic tiling allows one)."""
+    image = np.asarray(image, np.float32)
+    known = np.asarray(known, bool) & ~hole
+    if known.sum() < hole.sum():  # too little floor seen to tell a repeat from a coincidence
+        return None
+    translations = dominant_translations(image, known, hole)
+    shifts = candidate_shifts(translations.shifts[:_TRANSLATIONS], hole, seed=seed)
+    # planks of random shades repeat nothing as a whole, but match themselves along their length
+    if not translations.dominant and not (relative_difference(image, known, hole, shifts) <= DOMINANT).any():
+        return None
+    composed = shift_map(image, known, hole, shifts, footprint=footprint)
+    if not composed.covered.any():
+        return None
+    values, weight = _border_mismatch(image, known, composed)
+    fixed = weight > 0
+    correction = np.zeros_like(image)
+    if fixed.any():
+        correction = membrane(clip_outliers(values, fixed), fixed, composed.covered)
+    return StructureFill(image=np.where(composed.covered[..., None], composed.image + correction, image),
+                         correction=correction, shifts=composed, translations=translations)
+
+
+def _border_mismatch(image: np.ndarray, known: np.ndarray, composed: ShiftMap) -> tuple[np.ndarray, np.ndarray]:
+    """Per known pixel beside a covered hole pixel: its value minus what that pixel's shift copies
+    to its place, averaged over such neighbours; and how many there are."""
+    h, w = known.shape
+    total, count = np.zeros(image.shape, np.float32), np.zeros((h, w), np.float32)
+    ys, xs = np.nonzero(composed.covered)
+    t = composed.shifts[composed.labels[ys, xs]]
+    for dy, dx in _STEPS:
+        qy, qx = ys + dy, xs + dx
+        sy, sx = qy + t[:, 0], qx + t[:, 1]
+        ok = ((qy >= 0) & (qy < h) & (qx >= 0) & (qx < w) & (sy >= 0) & (sy < h) & (sx >= 0) & (sx < w))
+        ok[ok] &= known[qy[ok], qx[ok]] & known[sy[ok], sx[ok]]
+        np.add.at(total, (qy[ok], qx[ok]), image[qy[ok], qx[ok]] - image[sy[ok], sx[ok]])
+        np.add.at(count, (qy[ok], qx[ok]), 1.0)
+    return total / np.maximum(count, 1)[..., None], count

@@ -1,0 +1,131 @@
+"""Structure-aware fill: the translations of tiled and planked textures, the shift map that
+composes a hole from shifted copies, and the blend; against hand-made periodic arrays."""
+import numpy as np
+import pytest
+
+from addon.synthesis.shift_map import candidate_shifts, shift_map
+from addon.synthesis.structure import structure_fill
+from addon.synthesis.translations import dominant_translations
+
+
+def _tiles(size=160, period=20, grout=2, seed=0):
+    rng = np.random.default_rng(seed)
+    y, x = np.mgrid[:size, :size]
+    img = np.full((size, size, 3), 0.7) + 0.02 * rng.standard_normal((size, size, 1))
+    img[((y % period) < grout) | ((x % period) < grout)] = 0.25
+    return img.astype(np.float32)
+
+
+def _planks(size=160, width=12, length=72, seed=0):
+    """Planks along x of random shades, joints staggered by half a plank every other row."""
+    rng = np.random.default_rng(seed)
+    y, x = np.mgrid[:size, :size]
+    row = y // width
+    piece = (x + (row % 2) * length // 2) // length
+    shade = 0.4 + 0.3 * rng.random((size // width + 1, size // length + 2))
+    img = shade[row, piece][..., None] * np.array([1.0, 0.7, 0.45]) + 0.01 * rng.standard_normal((size, size, 1))
+    joint = ((y % width) == 0) | (((x + (row % 2) * length // 2) % length) == 0)
+    img[joint] *= 0.4
+    return img.astype(np.float32)
+
+
+def _noise(size=160, seed=0):
+    rng = np.random.default_rng(seed)
+    white = rng.standard_normal((size + 4, size + 4, 1))
+    smooth = sum(white[dy:dy + size, dx:dx + size] for dy in range(5) for dx in range(5)) / 5
+    return (0.5 + 0.08 * smooth * np.array([1.0, 0.9, 0.8])).astype(np.float32)
+
+
+def _hole(size, lo, hi):
+    m = np.zeros((size, size), bool)
+    m[lo:hi, lo + 5:hi + 9] = True
+    return m
+
+
+def _band_pass_correlation(out, truth, hole):
+    def bp(a):
+        y = a.mean(axis=2)
+        k = np.ones(3) / 3
+        s = np.apply_along_axis(lambda r: np.convolve(r, k, "same"), 0, y)
+        s = np.apply_along_axis(lambda r: np.convolve(r, k, "same"), 1, s)
+        return (y - s)[hole]
+    a, b = bp(out), bp(truth)
+    a, b = a - a.mean(), b - b.mean()
+    return float((a * b).sum() / np.sqrt((a * a).sum() * (b * b).sum()))
+
+
+def test_translations_of_tiles_are_their_period():
+    img = _tiles()
+    hole = _hole(160, 60, 100)
+    tr = dominant_translations(img, ~hole, hole)
+    assert tr.dominant
+    assert tr.contrast[0] < 0.3
+    # every shift found is a whole number of periods in both axes
+    assert np.all(tr.shifts % 20 == 0), tr.shifts
+
+
+def test_stochastic_texture_has_no_dominant_translation_and_no_structure_fill():
+    img = _noise()
+    hole = _hole(160, 60, 100)
+    assert not dominant_translations(img, ~hole, hole).dominant
+    assert structure_fill(img, ~hole, hole) is None
+
+
+# planks of random shades: the hidden planks' shades are not in the picture, their mean neither
+@pytest.mark.parametrize("texture, least, mean_off", [(_tiles, 0.9, 0.03), (_planks, 0.6, 0.1)])
+def test_structure_fill_continues_lines_in_phase(texture, least, mean_off):
+    truth = texture()
+    hole = _hole(160, 55, 105)
+    seen = np.where(hole[..., None], 0, truth)
+    got = structure_fill(seen, ~hole, hole)
+    assert got is not None and got.covered[hole].all()
+    out = got.image
+    assert np.all(out[~hole] == seen[~hole])
+    assert _band_pass_correlation(out, truth, hole) >= least
+    assert abs(out[hole].mean() / truth[hole].mean() - 1) < mean_off
+
+
+def test_mean_follows_surroundings_under_a_brightness_step():
+    """Copies from darker tiles farther off are brought to the hole's own surroundings."""
+    truth = _tiles()
+    y = np.mgrid[:160, :160][0]
+    lit = truth * (0.6 + 0.4 * (y < 120))[..., None]  # the far floor, where copies come from, darker
+    hole = _hole(160, 50, 90)
+    got = structure_fill(np.where(hole[..., None], 0, lit), ~hole, hole)
+    assert abs(got.image[hole].mean() / lit[hole].mean() - 1) < 0.05
+
+
+def test_same_seed_same_fill_other_seed_other_fill_of_the_same_quality():
+    truth = _planks(seed=3)
+    hole = _hole(160, 55, 105)
+    seen = np.where(hole[..., None], 0, truth)
+    a, b = (structure_fill(seen, ~hole, hole, seed=1).image for _ in range(2))
+    c = structure_fill(seen, ~hole, hole, seed=2).image
+    np.testing.assert_array_equal(a, b)
+    assert not np.array_equal(a, c)
+    assert abs(_band_pass_correlation(a, truth, hole) - _band_pass_correlation(c, truth, hole)) < 0.15
+
+
+def test_sharp_sources_preferred_over_coarse_ones():
+    """With the far half marked coarse, the copies come from the near half."""
+    img = _tiles()
+    hole = _hole(160, 60, 100)
+    y = np.mgrid[:160, :160][0]
+    footprint = np.where(y < 80, 4.0, 1.0)  # rows above the middle are resolved 4x more coarsely
+    footprint[hole] = 1.0
+    shifts = candidate_shifts(dominant_translations(img, ~hole, hole).shifts, hole)
+    got = shift_map(img, ~hole, hole, shifts, footprint=footprint)
+    ys, _ = np.nonzero(hole)
+    src_rows = ys + got.shifts[got.labels[hole], 0]
+    assert (src_rows >= 80).mean() > 0.9
+
+
+def test_shift_map_leaves_what_no_shift_reaches():
+    img = _tiles()
+    hole = np.zeros((160, 160), bool)
+    hole[:, 70:90] = True  # a strip: vertical shifts never leave it
+    got = shift_map(img, ~hole, hole, np.array([[20, 0], [-20, 0]]))
+    assert not got.covered.any()
+    np.testing.assert_array_equal(got.image, img)
+    got = shift_map(img, ~hole, hole, np.array([[0, 20], [0, -20]]))
+    assert got.covered[hole].all()
