@@ -2,10 +2,17 @@
 people use today, on procedural floor textures with a square hole in the middle.
 
 Prints a markdown table per case and a summary per method and hole size. Quality against the
-known truth inside the hole: MAE (mean absolute error; low only where the fill can be predicted,
-as for tile lines or a gradient, never for noise), detail (high-pass std, result / truth: 1 is
-right, below is blur) and seam (mean gradient magnitude on the 2 px either side of the hole's
-border, result / truth: above 1 is a visible seam, below is a flattened border).
+known truth inside the hole: structure (correlation of the fill's band-pass luminance, box blur
+of radius 1 minus box blur of radius 4, with the truth's: 1 = edges and lines where they really
+run, 0 = out of phase or flat; `scenes.metrics.structure_correlation`), MAE (mean absolute
+error; low only where the fill can be predicted, as for tile lines or a gradient, never for
+noise), detail (high-pass std, result / truth: 1 is right, below is blur) and seam (mean
+gradient magnitude on the 2 px either side of the hole's border, result / truth: above 1 is a
+visible seam, below is a flattened border).
+
+Ours is the add-on's fill: the hole composed from shifted copies where the texture repeats
+(`addon.synthesis.structure`), the rest by the order-independent synthesis; "ours per-pixel" is
+that synthesis alone (the fill before the structure-aware one), "ours exhaustive" its exact search.
 
 The outside baselines are optional, benchmark-only dependencies (pins in
 benchmarks/requirements-synthesis.txt; install them into a separate venv, e.g.
@@ -38,13 +45,19 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
+from addon.synthesis.structure import fill_structured
 from addon.synthesis.texture import SynthesisParams, fill
-from textures import TEXTURES, lighting
+from scenes.metrics import structure_correlation
+from textures import DEFAULT, TEXTURES, lighting
 
 Method = Callable[[np.ndarray, np.ndarray], np.ndarray]  # (image, hole) -> filled image
 
 
-def ours(search: str) -> Method:
+def ours() -> Method:
+    return lambda img, hole: fill_structured(img, ~hole, hole, SynthesisParams())[0]
+
+
+def per_pixel(search: str) -> Method:
     return lambda img, hole: fill(img, ~hole, hole, SynthesisParams(search=search))
 
 
@@ -119,12 +132,13 @@ def border_ring(hole: np.ndarray, *, width: int = 2) -> np.ndarray:
     return np.any(shifts, axis=0) & ~np.all(shifts, axis=0)
 
 
-def quality(out: np.ndarray, truth: np.ndarray, hole: np.ndarray) -> tuple[float, float, float]:
+def quality(out: np.ndarray, truth: np.ndarray, hole: np.ndarray) -> tuple[float, float, float, float]:
+    structure = structure_correlation(out, truth, hole)
     mae = float(np.abs(out - truth)[hole].mean())
     detail = float((out - blur(out))[hole].std() / (truth - blur(truth))[hole].std())
     ring = border_ring(hole)
     seam = float(gradient_magnitude(out)[ring].mean() / gradient_magnitude(truth)[ring].mean())
-    return mae, detail, seam
+    return structure, mae, detail, seam
 
 
 def case_inputs(case: str, texture: np.ndarray, hole: np.ndarray
@@ -144,7 +158,7 @@ def case_inputs(case: str, texture: np.ndarray, hole: np.ndarray
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--sizes", default="32,64,128,256", help="hole sides in pixels, comma separated")
-    ap.add_argument("--textures", default=",".join(TEXTURES))
+    ap.add_argument("--textures", default=",".join(DEFAULT), help=f"comma separated, of {', '.join(TEXTURES)}")
     ap.add_argument("--image", type=int, default=512, help="side of the square test images")
     ap.add_argument("--exhaustive-max", type=int, default=64, help="largest hole the exhaustive search runs on")
     ap.add_argument("--quick", action="store_true", help="holes 64 and 128 only, no exhaustive search")
@@ -156,7 +170,8 @@ def main() -> None:
     sizes = [64, 128] if args.quick else [int(s) for s in args.sizes.split(",")]
     exhaustive_max = 0 if args.quick else args.exhaustive_max
 
-    methods: dict[str, Method | str] = {"ours accelerated": ours("accelerated"), "ours exhaustive": ours("exhaustive")}
+    methods: dict[str, Method | str] = {"ours": ours(), "ours per-pixel": per_pixel("accelerated"),
+                                        "ours exhaustive": per_pixel("exhaustive")}
     for name, make in (("OpenCV Telea", telea), ("skimage biharmonic", biharmonic), ("PatchMatch", patchmatch),
                        ("Resynthesizer", resynthesizer)):
         try:
@@ -168,8 +183,8 @@ def main() -> None:
 
     print(f"{args.image}x{args.image} images, square hole in the middle; default parameters {SynthesisParams()}")
     print()
-    print("| case | texture | hole | method | s | MAE | detail | seam |")
-    print("|---|---|---|---|---|---|---|---|")
+    print("| case | texture | hole | method | s | structure | MAE | detail | seam |")
+    print("|---|---|---|---|---|---|---|---|---|")
     rows = []
     for case in args.cases.split(","):
         for texture in args.textures.split(","):
@@ -184,7 +199,7 @@ def main() -> None:
                     if isinstance(method, str) or (name == "ours exhaustive" and size > exhaustive_max):
                         why = method if isinstance(method, str) else (
                             "skipped (--quick)" if args.quick else f"skipped (holes <= {exhaustive_max} px only)")
-                        print(f"{label} {why} | | | |", flush=True)
+                        print(f"{label} {why} | | | | |", flush=True)
                         continue
                     seconds = np.inf
                     for _ in range(args.repeat):  # every method is deterministic: the runs differ in time only
@@ -195,22 +210,24 @@ def main() -> None:
                         else:
                             out = method(seen, hole)
                         seconds = min(seconds, time.perf_counter() - t0)
-                    mae, detail, seam = quality(np.where(hole[..., None], out, truth), truth, hole)
-                    rows.append((case, name, size, seconds, mae, detail, seam))
-                    print(f"{label} {seconds:.2f} | {mae:.4f} | {detail:.2f} | {seam:.2f} |", flush=True)
+                    structure, mae, detail, seam = quality(np.where(hole[..., None], out, truth), truth, hole)
+                    rows.append((case, name, size, seconds, structure, mae, detail, seam))
+                    print(f"{label} {seconds:.2f} | {structure:.2f} | {mae:.4f} | {detail:.2f} | {seam:.2f} |",
+                          flush=True)
 
     print()
     print("Mean over the textures:")
     print()
-    print("| case | method | hole | s | MAE | detail | seam |")
-    print("|---|---|---|---|---|---|---|")
+    print("| case | method | hole | s | structure | MAE | detail | seam |")
+    print("|---|---|---|---|---|---|---|---|")
     for case in dict.fromkeys(r[0] for r in rows):
         for name in dict.fromkeys(r[1] for r in rows):
             for size in sizes:
                 sel = np.array([r[3:] for r in rows if r[:3] == (case, name, size)])
                 if len(sel):
-                    s, mae, detail, seam = sel.mean(axis=0)
-                    print(f"| {case} | {name} | {size} | {s:.2f} | {mae:.4f} | {detail:.2f} | {seam:.2f} |")
+                    s, structure, mae, detail, seam = sel.mean(axis=0)
+                    print(f"| {case} | {name} | {size} | {s:.2f} | {structure:.2f} | {mae:.4f} | {detail:.2f} "
+                          f"| {seam:.2f} |")
 
 
 if __name__ == "__main__":
