@@ -21,11 +21,11 @@ from .texture import SynthesisParams
 _MAX_CELLS = 512 * 512  # bounds the raster (and the exemplar) whatever the panorama size
 _DEPTH_TOLERANCE = 0.02  # relative: a cell is where a ray meets its surface within this
 _MIN_KNOWN = 64  # visible cells a surface needs to serve as its own exemplar
-# Copies read the panorama with bilinear weights steepened this much: plain bilinear averages
-# away a third of the fine detail (detail ratio 0.71-0.76 on the demo and basic_box at 1024),
-# the nearest pixel keeps it all but makes lines jagged (structure 0.93 -> 0.90); 2 gives
-# 0.86-0.91 and 0.92.
-_SHARPEN = 2.0
+# Copies read the panorama with bilinear weights steepened this much. 2 kept the fine detail
+# at 1024x512 (detail ratio 0.71-0.76 -> 0.86-0.91) but copied the near floor's sharper grain
+# into the blurred far floor at 256x128 (stool: 1.07 -> 1.70): a copy would have to be blurred
+# to its target's resolution first, which is not done yet; plain bilinear until then.
+_SHARPEN = 1.0
 
 
 @dataclass(frozen=True)
