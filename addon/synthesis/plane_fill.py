@@ -124,8 +124,9 @@ def fill_surface(
         on_level = None if progress is None else (
             lambda _level, preview: progress(planeraster.sample_raster(raster, preview, points)))
         try:
+            footprint = _footprint(raster) if options.structure else None
             image, structure = fill_structured(image, known, hole, options.synthesis, structure=options.structure,
-                                               footprint=_footprint(raster), seed=options.seed, progress=on_level,
+                                               footprint=footprint, seed=options.seed, progress=on_level,
                                                cancel=cancel)
             synthesised = True
         except DimredError:

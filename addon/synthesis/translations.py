@@ -13,6 +13,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..segmentation.masks import box_mean
+
 _COARSE_SIDE = 160  # the FFT runs on a copy at most this many blocks across: a few ms
 _MIN_OVERLAP = 0.2  # a shift counts where this share of the known pixels stays known under it
 # A translation is dominant where the texture differs from itself by at most this share of its
@@ -50,7 +52,7 @@ def dominant_translations(image: np.ndarray, known: np.ndarray, hole: np.ndarray
     full = weight >= 0.999
     # Edges, not shades: planks of random shades still repeat their joints, and the lamp's
     # falloff left in the reflectance would make every short shift look alike.
-    values = values - _local_mean(values, full)
+    values = values - box_mean(values[..., None], full, 2)[0][..., 0]
     d, overlap = _self_difference(values, full)
     ty = np.arange(-(values.shape[0] - 1), values.shape[0])
     tx = np.arange(-(values.shape[1] - 1), values.shape[1])
@@ -92,20 +94,6 @@ def _block_mean(values: np.ndarray, known: np.ndarray, block: int) -> tuple[np.n
     k = np.pad(known.astype(np.float64), pad).reshape(hb, block, wb, block).sum(axis=(1, 3))
     v = np.pad(np.where(known, values, 0.0), pad).reshape(hb, block, wb, block).sum(axis=(1, 3))
     return v / np.maximum(k, 1), k / block**2
-
-
-def _local_mean(values: np.ndarray, valid: np.ndarray, radius: int = 2) -> np.ndarray:
-    """Mean of the valid values over the (2 radius + 1)^2 square around each pixel."""
-    n = 2 * radius + 1
-    total = np.zeros_like(values)
-    count = np.zeros_like(values)
-    v, m = np.pad(np.where(valid, values, 0.0), radius), np.pad(valid.astype(np.float64), radius)
-    h, w = values.shape
-    for dy in range(n):
-        for dx in range(n):
-            total += v[dy:dy + h, dx:dx + w]
-            count += m[dy:dy + h, dx:dx + w]
-    return total / np.maximum(count, 1)
 
 
 def _self_difference(values: np.ndarray, valid: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
