@@ -14,6 +14,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .translations import relative_difference
+
 _MAX_BLOCKS = 1500  # blocks the belief propagation runs on: its cost is blocks x shifts^2
 _ITERATIONS = 24
 _DAMPING = 0.5
@@ -57,6 +59,34 @@ def candidate_shifts(translations: np.ndarray, hole: np.ndarray, *, along: int =
     shifts = np.concatenate([np.asarray(translations, np.int64).reshape(-1, 2), axis])
     _, first = np.unique(shifts, axis=0, return_index=True)
     return shifts[np.sort(first)]
+
+
+def lattice_shifts(translations: np.ndarray, image: np.ndarray, known: np.ndarray, hole: np.ndarray, *,
+                   count: int = 24, min_shift: int = 6) -> np.ndarray:
+    """The shifts to choose from on a periodic texture: its translations, their opposites, sums,
+    differences and doubles, at least `min_shift` and at most 1.5 times the hole's extent long,
+    the `count` that match the known surroundings best (`relative_difference`; those too long to
+    check last, shortest first), none within 1.5 cells of a better one. Every label is a repeat,
+    so neighbouring copies stay in phase; a shift along the floor's axes of some other length
+    puts tiles out of phase wherever the border cannot tell (a band of shadow the lighting
+    stage left there reads as a dark tile)."""
+    base = np.asarray(translations, np.int64).reshape(-1, 2)
+    base = np.concatenate([base, -base])
+    i, j = np.triu_indices(len(base), 1)
+    lattice = np.unique(np.concatenate([base, base[i] + base[j], 2 * base]), axis=0)
+    ys, xs = np.nonzero(hole)
+    extent = max(int(np.ptp(ys)), int(np.ptp(xs)), 1) + 1
+    length = np.hypot(*lattice.T)
+    lattice = lattice[(length >= min_shift) & (length <= max(1.5 * extent, np.hypot(*base.T).max()))]
+    score = relative_difference(image, known, hole, lattice)
+    order = np.lexsort((np.hypot(*lattice.T), score))
+    chosen: list[np.ndarray] = []
+    for s in lattice[order]:
+        if len(chosen) == count:
+            break
+        if not chosen or np.hypot(*(np.asarray(chosen) - s).T).min() > 1.5:
+            chosen.append(s)
+    return np.asarray(chosen, np.int64).reshape(-1, 2)
 
 
 def shift_map(image: np.ndarray, known: np.ndarray, hole: np.ndarray, shifts: np.ndarray, *,

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .shift_map import ShiftMap, candidate_shifts, shift_map
+from .shift_map import ShiftMap, candidate_shifts, lattice_shifts, shift_map
 from .texture import CancelFn, ProgressFn, SynthesisParams, clip_outliers, fill, membrane
 from .translations import DOMINANT, Translations, dominant_translations, relative_difference
 
@@ -53,10 +53,13 @@ def structure_fill(image: np.ndarray, known: np.ndarray, hole: np.ndarray, *, fo
     translations = dominant_translations(image, known, hole)
     if translations.dominant and np.hypot(*translations.shifts[:_TRANSLATIONS].T).min() < min_period:
         return None
-    shifts = candidate_shifts(translations.shifts[:_TRANSLATIONS], hole, seed=seed)
-    # planks of random shades repeat nothing as a whole, but match themselves along their length
-    if not translations.dominant and not (relative_difference(image, known, hole, shifts) <= DOMINANT).any():
-        return None
+    if translations.dominant:
+        shifts = lattice_shifts(translations.shifts[:_TRANSLATIONS], image, known, hole)
+    else:
+        shifts = candidate_shifts(translations.shifts[:_TRANSLATIONS], hole, seed=seed)
+        # planks of random shades repeat nothing as a whole, but match themselves along their length
+        if not (relative_difference(image, known, hole, shifts) <= DOMINANT).any():
+            return None
     composed = shift_map(image, known, hole, shifts, footprint=footprint)
     if not composed.covered.any():
         return None
