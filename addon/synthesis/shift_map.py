@@ -62,11 +62,13 @@ def candidate_shifts(translations: np.ndarray, hole: np.ndarray, *, along: int =
 
 
 def lattice_shifts(translations: np.ndarray, image: np.ndarray, known: np.ndarray, hole: np.ndarray, *,
-                   count: int = 24, min_shift: int = 6) -> np.ndarray:
+                   count: int = 24, min_shift: int = 6, seed: int = 0) -> np.ndarray:
     """The shifts to choose from on a periodic texture: its translations, their opposites, sums,
     differences and doubles, at least `min_shift` and at most 1.5 times the hole's extent long,
     the `count` that match the known surroundings best (`relative_difference`; those too long to
-    check last, shortest first), none within 1.5 cells of a better one. Every label is a repeat,
+    check last, shortest first), none within 1.5 cells of a better one. A `seed` other than 0
+    ranks them by a score scattered by up to 30 %: another set of good repeats, another choice of
+    copies, equally in phase. Every label is a repeat,
     so neighbouring copies stay in phase; a shift along the floor's axes of some other length
     puts tiles out of phase wherever the border cannot tell (a band of shadow the lighting
     stage left there reads as a dark tile)."""
@@ -79,6 +81,8 @@ def lattice_shifts(translations: np.ndarray, image: np.ndarray, known: np.ndarra
     length = np.hypot(*lattice.T)
     lattice = lattice[(length >= min_shift) & (length <= max(1.5 * extent, np.hypot(*base.T).max()))]
     score = relative_difference(image, known, hole, lattice)
+    if seed:
+        score = score * (1.0 + 0.3 * (2 * np.random.default_rng(seed).random(len(score)) - 1))
     order = np.lexsort((np.hypot(*lattice.T), score))
     chosen: list[np.ndarray] = []
     for s in lattice[order]:

@@ -43,8 +43,8 @@ def structure_fill(image: np.ndarray, known: np.ndarray, hole: np.ndarray, *, fo
                    seed: int = 0, min_period: float = 0.0) -> StructureFill | None:
     """The `hole` of `image` (H, W, C) composed from shifted copies of its `known` pixels, or
     None where the texture has no dominant translation or no copy reaches the hole. `seed`
-    varies the axis shifts' lengths: another seed gives another, equally continuous fill
-    where the texture allows more than one (a periodic tiling allows one). A texture whose
+    varies the labels (the axis shifts' lengths, or which repeats of a tiling): another seed
+    gives another, equally continuous fill. A texture whose
     shortest repeat is under `min_period` cells is left to the per-pixel synthesis (None)."""
     image = np.asarray(image, np.float32)
     known = np.asarray(known, bool) & ~hole
@@ -54,7 +54,7 @@ def structure_fill(image: np.ndarray, known: np.ndarray, hole: np.ndarray, *, fo
     if translations.dominant and np.hypot(*translations.shifts[:_TRANSLATIONS].T).min() < min_period:
         return None
     if translations.dominant:
-        shifts = lattice_shifts(translations.shifts[:_TRANSLATIONS], image, known, hole)
+        shifts = lattice_shifts(translations.shifts[:_TRANSLATIONS], image, known, hole, seed=seed)
     else:
         shifts = candidate_shifts(translations.shifts[:_TRANSLATIONS], hole, seed=seed)
         # planks of random shades repeat nothing as a whole, but match themselves along their length

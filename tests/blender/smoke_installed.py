@@ -182,7 +182,8 @@ def main(argv: list[str]) -> int:
     os.environ["BLENDER_USER_RESOURCES"] = str(work / "user")
     import bpy
 
-    print(f"smoke: Blender {bpy.app.version_string}, Python {sys.version.split()[0]}, numpy {np.__version__}")
+    print(f"smoke: Blender {bpy.app.version_string}, Python {sys.version.split()[0]}, numpy {np.__version__}",
+          flush=True)
     passed = failed = 0
 
     def step(name: str, fn: Callable, *args):
@@ -210,10 +211,11 @@ def main(argv: list[str]) -> int:
     except Exception:
         pass  # step() printed it; every later step depends on this one
     if failed:
-        print(f"smoke: files kept in {work}")
+        print(f"smoke: files kept in {work}", flush=True)
     else:
         shutil.rmtree(work, ignore_errors=True)
-    print(f"smoke: {passed} passed, {failed} failed")
+    # flushed now: Blender's exit handler may end the process before Python flushes its buffers
+    print(f"smoke: {passed} passed, {failed} failed", flush=True)
     return 1 if failed else 0
 
 
