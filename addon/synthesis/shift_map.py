@@ -16,10 +16,10 @@ import numpy as np
 
 from .translations import relative_difference
 
-_MAX_BLOCKS = 1500  # blocks the belief propagation runs on: its cost is blocks x shifts^2
-_ITERATIONS = 24
+_MAX_BLOCKS = 800  # blocks the belief propagation runs on: its cost is blocks x shifts^2
+_ITERATIONS = 16
 _DAMPING = 0.5
-_SWEEPS = 3  # pixel-level ICM sweeps after the blocks (each both checkerboard colours)
+_SWEEPS = 2  # pixel-level ICM sweeps after the blocks (each both checkerboard colours)
 _TRUNCATE = 4.0  # one seam edge costs at most this many times the texture's variance
 _UNREACHABLE = 1e3  # times the variance: a shift whose source is not known
 _RESOLUTION = 0.5  # times the variance per octave a source is coarser than the pixel it fills
@@ -182,6 +182,34 @@ def _pair_cost(copies: np.ndarray, i: np.ndarray, j: np.ndarray, variance: float
     return np.minimum(np.maximum(disagree(ci) + disagree(cj), 0.0) / variance, _TRUNCATE).astype(np.float32)
 
 
+@dataclass(frozen=True)
+class _Groups:
+    """Rows of (E, ...) arrays summed into `n` rows by a fixed index (sorted once, then
+    np.add.reduceat: np.add.at is several times slower, and message passing sums every iteration)."""
+
+    order: np.ndarray
+    starts: np.ndarray
+    targets: np.ndarray
+    n: int
+
+    @classmethod
+    def of(cls, index: np.ndarray, n: int) -> _Groups:
+        order = np.argsort(index, kind="stable")
+        sorted_index = index[order]
+        starts = np.flatnonzero(np.r_[True, sorted_index[1:] != sorted_index[:-1]]) if len(index) else order
+        return cls(order, starts, sorted_index[starts], n)
+
+    def sum(self, values: np.ndarray) -> np.ndarray:
+        out = np.zeros((self.n, *values.shape[1:]), values.dtype)
+        if len(self.order):
+            out[self.targets] = np.add.reduceat(values[self.order], self.starts, axis=0)
+        return out
+
+
+def _grouped_sum(index: np.ndarray, n: int, values: np.ndarray) -> np.ndarray:
+    return _Groups.of(index, n).sum(values)
+
+
 def _block_labels(unary: np.ndarray, copies: np.ndarray, pairs: np.ndarray, ys: np.ndarray, xs: np.ndarray,
                   variance: float) -> np.ndarray:
     """(N,) a shift per hole pixel, one per block of pixels, by damped min-sum belief
@@ -190,8 +218,7 @@ def _block_labels(unary: np.ndarray, copies: np.ndarray, pairs: np.ndarray, ys: 
     by, bx = ys // side, xs // side
     _, block = np.unique(by * (bx.max() + 1) + bx, return_inverse=True)
     nb, k = int(block.max()) + 1, unary.shape[1]
-    u = np.zeros((nb, k), np.float32)
-    np.add.at(u, block, unary)
+    u = _grouped_sum(block, nb, unary)
     cross = block[pairs[:, 0]] != block[pairs[:, 1]]
     i, j = pairs[cross, 0], pairs[cross, 1]
     if not len(i):
@@ -201,25 +228,26 @@ def _block_labels(unary: np.ndarray, copies: np.ndarray, pairs: np.ndarray, ys: 
     swap = bi > bj
     i, j = np.where(swap, j, i), np.where(swap, i, j)
     edge_key, edge = np.unique(block[i] * nb + block[j], return_inverse=True)
+    order = np.argsort(edge, kind="stable")
+    i, j, edge = i[order], j[order], edge[order]
     v = np.zeros((len(edge_key), k, k), np.float32)
-    for lo in range(0, len(i), 4096):  # (E, K, K) temporaries in pieces
-        np.add.at(v, edge[lo:lo + 4096], _pair_cost(copies, i[lo:lo + 4096], j[lo:lo + 4096], variance))
+    for lo in range(0, len(i), 4096):  # (E, K, K) temporaries in pieces; a block pair may span two
+        v += _grouped_sum(edge[lo:lo + 4096], len(edge_key), _pair_cost(copies, i[lo:lo + 4096], j[lo:lo + 4096],
+                                                                        variance))
     src, dst = edge_key // nb, edge_key % nb
     # directed edges: e and e + E are the two directions of one pair
     tail, head = np.concatenate([src, dst]), np.concatenate([dst, src])
     cost = np.concatenate([v, v.transpose(0, 2, 1)])  # cost[e][a, b]: tail takes a, head b
     reverse = np.concatenate([np.arange(len(src)) + len(src), np.arange(len(src))])
     messages = np.zeros((len(tail), k), np.float32)
+    into = _Groups.of(head, nb)
     for _ in range(_ITERATIONS):
-        incoming = u.copy()
-        np.add.at(incoming, head, messages)
+        incoming = u + into.sum(messages)
         h = incoming[tail] - messages[reverse]
         new = (h[:, :, None] + cost).min(axis=1)
         new -= new.min(axis=1, keepdims=True)
         messages = _DAMPING * messages + (1 - _DAMPING) * new
-    belief = u.copy()
-    np.add.at(belief, head, messages)
-    return belief.argmin(axis=1)[block]
+    return (u + into.sum(messages)).argmin(axis=1)[block]
 
 
 def _settle(label: np.ndarray, colour: np.ndarray, unary: np.ndarray, copies: np.ndarray, pairs: np.ndarray,
@@ -231,13 +259,11 @@ def _settle(label: np.ndarray, colour: np.ndarray, unary: np.ndarray, copies: np
     # directed: p's cost depends on q's shift
     p, q = np.concatenate([pairs[:, 1], pairs[:, 0]]), np.concatenate([pairs[:, 0], pairs[:, 1]])
     label = label.copy()
+    sides = [(colour[p] == c, colour == c) for c in (0, 1)]
+    into = [_Groups.of(p[sel], n) for sel, _ in sides]
     for _ in range(_SWEEPS):
-        for c in (0, 1):
-            sel = colour[p] == c
-            cost = unary.copy()
-            seam = _seam_to(copies, p[sel], q[sel], label[q[sel]], variance)
-            np.add.at(cost, p[sel], seam)
-            mine = colour == c
+        for (sel, mine), groups in zip(sides, into, strict=True):
+            cost = unary + groups.sum(_seam_to(copies, p[sel], q[sel], label[q[sel]], variance))
             label[mine] = cost[mine].argmin(axis=1)
     total = float(unary[np.arange(n), label].sum())
     total += float(_seam_to(copies, pairs[:, 0], pairs[:, 1], label[pairs[:, 1]], variance)

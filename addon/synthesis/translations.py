@@ -39,6 +39,16 @@ class Translations:
         shift that matches it much better than any other."""
         return bool(len(self.shifts)) and float(self.contrast[0]) <= DOMINANT
 
+    @property
+    def tiling(self) -> bool:
+        """Whether the dominant translations span the plane (two of them at least 15 degrees
+        apart): a grid of tiles. Wood grain and rows of planks repeat along one direction only."""
+        t = self.shifts[self.contrast <= DOMINANT].astype(np.float64)
+        if len(t) < 2:
+            return False
+        cross = np.abs(t[:, None, 0] * t[None, :, 1] - t[:, None, 1] * t[None, :, 0])
+        return bool((cross > np.sin(np.radians(15)) * np.outer(*(2 * [np.hypot(*t.T)]))).any())
+
 
 def dominant_translations(image: np.ndarray, known: np.ndarray, hole: np.ndarray, *, count: int = 16,
                           min_shift: int = 6) -> Translations:
