@@ -153,18 +153,15 @@ def sample_panorama(raster: PlaneRaster, image: np.ndarray, valid: np.ndarray, *
     return sample_points(raster.points(), image, valid, frame=frame)
 
 
-def sample_points(points: np.ndarray, image: np.ndarray, valid: np.ndarray, *, frame: Frame | None = None,
-                  sharpen: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
-    """`sample_panorama` at any points (..., 3) in the probe frame: (..., C) and (...).
-    `sharpen` > 1 steepens the bilinear weights towards the nearest pixel (1: bilinear)."""
+def sample_points(points: np.ndarray, image: np.ndarray, valid: np.ndarray, *, frame: Frame | None = None
+                  ) -> tuple[np.ndarray, np.ndarray]:
+    """`sample_panorama` at any points (..., 3) in the probe frame: (..., C) and (...)."""
     frame = frame or Frame.whole(image.shape)
     u, v = latlong.direction_to_uv(points)
     x = u * frame.width - 0.5
     y = np.clip((1.0 - v) * frame.height - 0.5, 0.0, frame.height - 1.0)  # clamped at the poles
     x0, y0 = np.floor(x), np.floor(y)
     fx, fy = x - x0, y - y0
-    if sharpen != 1.0:
-        fx, fy = (np.clip((f - 0.5) * sharpen + 0.5, 0.0, 1.0) for f in (fx, fy))
     total = np.zeros((*u.shape, image.shape[2]))
     weight = np.zeros(u.shape)
     for dy, wy in ((0, 1.0 - fy), (1, fy)):

@@ -21,11 +21,6 @@ from .texture import SynthesisParams
 _MAX_CELLS = 512 * 512  # bounds the raster (and the exemplar) whatever the panorama size
 _DEPTH_TOLERANCE = 0.02  # relative: a cell is where a ray meets its surface within this
 _MIN_KNOWN = 64  # visible cells a surface needs to serve as its own exemplar
-# Copies read the panorama with bilinear weights steepened this much. 2 kept the fine detail
-# at 1024x512 (detail ratio 0.71-0.76 -> 0.86-0.91) but copied the near floor's sharper grain
-# into the blurred far floor at 256x128 (stool: 1.07 -> 1.70): a copy would have to be blurred
-# to its target's resolution first, which is not done yet; plain bilinear until then.
-_SHARPEN = 1.0
 
 
 @dataclass(frozen=True)
@@ -154,7 +149,10 @@ def _copied(rho: np.ndarray, panorama: PanoramaReflectance, plane: HiddenPlane, 
     """The hidden points whose cell the shift map composed read their copy from the panorama
     itself, at the point moved by the cell's shift, plus the blend's smooth correction: one
     resampling of the photograph instead of two (panorama to raster to panorama), which kept
-    about 60 % of the fine detail, and with steepened bilinear weights (`_SHARPEN`)."""
+    about 60 % of the fine detail. Bilinear still averages some away; bilinear weights steepened
+    towards the nearest pixel kept it at 1024x512 but copied the near floor's sharper grain into
+    the blurred far floor at 256x128, and blurring each copy to its target's footprint lost the
+    render noise that is much of the truth's pixel detail (README, "Structure first")."""
     maps = panorama.maps
     r, c = (np.clip(np.rint(x).astype(np.int64), 0, n - 1) for x, n in zip(raster.coords(plane.points), raster.shape,
                                                                             strict=True))
@@ -165,8 +163,7 @@ def _copied(rho: np.ndarray, panorama: PanoramaReflectance, plane: HiddenPlane, 
     t = structure.shifts.shifts[label[sel]] * raster.cell
     source = plane.points[sel] + t[:, :1] * raster.v + t[:, 1:] * raster.u
     copy, weight = planeraster.sample_points(source, panorama.rho,
-                                             panorama.valid & (maps.surface_with == plane.surface), frame=maps.frame,
-                                             sharpen=_SHARPEN)
+                                             panorama.valid & (maps.surface_with == plane.surface), frame=maps.frame)
     correction = planeraster.sample_raster(raster, structure.correction, plane.points[sel])
     ok = weight > 0.5
     out = rho.copy()

@@ -23,7 +23,7 @@ _SWEEPS = 2  # pixel-level ICM sweeps after the blocks (each both checkerboard c
 _TRUNCATE = 4.0  # one seam edge costs at most this many times the texture's variance
 _UNREACHABLE = 1e3  # times the variance: a shift whose source is not known
 _RESOLUTION = 0.5  # times the variance per octave a source is coarser than the pixel it fills
-_STEPS = ((0, 1), (1, 0), (0, -1), (-1, 0))
+NEIGHBOURS4 = ((0, 1), (1, 0), (0, -1), (-1, 0))  # (dy, dx) of a pixel's 4-neighbours
 
 
 @dataclass(frozen=True)
@@ -49,8 +49,7 @@ def candidate_shifts(translations: np.ndarray, hole: np.ndarray, *, along: int =
     each jittered by up to 15 % as the `seed` draws. The axis shifts continue a plank or a tile
     row from its visible ends whatever the lengths of the planks, which the translations alone
     cannot when their shades differ."""
-    ys, xs = np.nonzero(hole)
-    extent = max(int(np.ptp(ys)), int(np.ptp(xs)), 1) + 1
+    extent = _extent(hole)
     jitter = 1.0 + 0.15 * (2 * np.random.default_rng(seed).random(along) - 1) if seed else np.ones(along)
     lengths = np.unique(np.maximum(np.rint(extent * 1.5 ** (np.arange(along) - along + 2) * jitter), 2
                                    ).astype(np.int64))
@@ -68,16 +67,14 @@ def lattice_shifts(translations: np.ndarray, image: np.ndarray, known: np.ndarra
     the `count` that match the known surroundings best (`relative_difference`; those too long to
     check last, shortest first), none within 1.5 cells of a better one. A `seed` other than 0
     ranks them by a score scattered by up to 30 %: another set of good repeats, another choice of
-    copies, equally in phase. Every label is a repeat,
-    so neighbouring copies stay in phase; a shift along the floor's axes of some other length
-    puts tiles out of phase wherever the border cannot tell (a band of shadow the lighting
-    stage left there reads as a dark tile)."""
+    copies, equally in phase. Every label is a repeat, so neighbouring copies stay in phase; a
+    shift along the floor's axes of some other length puts tiles out of phase wherever the
+    border cannot tell (a band of shadow the lighting stage left there reads as a dark tile)."""
     base = np.asarray(translations, np.int64).reshape(-1, 2)
     base = np.concatenate([base, -base])
     i, j = np.triu_indices(len(base), 1)
     lattice = np.unique(np.concatenate([base, base[i] + base[j], 2 * base]), axis=0)
-    ys, xs = np.nonzero(hole)
-    extent = max(int(np.ptp(ys)), int(np.ptp(xs)), 1) + 1
+    extent = _extent(hole)
     length = np.hypot(*lattice.T)
     lattice = lattice[(length >= min_shift) & (length <= max(1.5 * extent, np.hypot(*base.T).max()))]
     score = relative_difference(image, known, hole, lattice)
@@ -91,6 +88,12 @@ def lattice_shifts(translations: np.ndarray, image: np.ndarray, known: np.ndarra
         if not chosen or np.hypot(*(np.asarray(chosen) - s).T).min() > 1.5:
             chosen.append(s)
     return np.asarray(chosen, np.int64).reshape(-1, 2)
+
+
+def _extent(hole: np.ndarray) -> int:
+    """The hole's bounding box's longer side, in cells."""
+    ys, xs = np.nonzero(hole)
+    return max(int(np.ptp(ys)), int(np.ptp(xs)), 1) + 1
 
 
 def shift_map(image: np.ndarray, known: np.ndarray, hole: np.ndarray, shifts: np.ndarray, *,
@@ -148,7 +151,7 @@ def _border_cost(image: np.ndarray, known: np.ndarray, hole: np.ndarray, ys: np.
     costs the truncation)."""
     h, w = hole.shape
     cost = np.zeros((len(ys), len(shifts)), np.float32)
-    for dy, dx in _STEPS:
+    for dy, dx in NEIGHBOURS4:
         qy, qx = ys + dy, xs + dx
         inside = (qy >= 0) & (qy < h) & (qx >= 0) & (qx < w)
         beside = inside & _at(known, qy, qx)
@@ -200,14 +203,12 @@ class _Groups:
         return cls(order, starts, sorted_index[starts], n)
 
     def sum(self, values: np.ndarray) -> np.ndarray:
-        out = np.zeros((self.n, *values.shape[1:]), values.dtype)
+        return self.add_into(np.zeros((self.n, *values.shape[1:]), values.dtype), values)
+
+    def add_into(self, out: np.ndarray, values: np.ndarray) -> np.ndarray:
         if len(self.order):
-            out[self.targets] = np.add.reduceat(values[self.order], self.starts, axis=0)
+            out[self.targets] += np.add.reduceat(values[self.order], self.starts, axis=0)
         return out
-
-
-def _grouped_sum(index: np.ndarray, n: int, values: np.ndarray) -> np.ndarray:
-    return _Groups.of(index, n).sum(values)
 
 
 def _block_labels(unary: np.ndarray, copies: np.ndarray, pairs: np.ndarray, ys: np.ndarray, xs: np.ndarray,
@@ -218,7 +219,7 @@ def _block_labels(unary: np.ndarray, copies: np.ndarray, pairs: np.ndarray, ys: 
     by, bx = ys // side, xs // side
     _, block = np.unique(by * (bx.max() + 1) + bx, return_inverse=True)
     nb, k = int(block.max()) + 1, unary.shape[1]
-    u = _grouped_sum(block, nb, unary)
+    u = _Groups.of(block, nb).sum(unary)
     cross = block[pairs[:, 0]] != block[pairs[:, 1]]
     i, j = pairs[cross, 0], pairs[cross, 1]
     if not len(i):
@@ -232,8 +233,8 @@ def _block_labels(unary: np.ndarray, copies: np.ndarray, pairs: np.ndarray, ys: 
     i, j, edge = i[order], j[order], edge[order]
     v = np.zeros((len(edge_key), k, k), np.float32)
     for lo in range(0, len(i), 4096):  # (E, K, K) temporaries in pieces; a block pair may span two
-        v += _grouped_sum(edge[lo:lo + 4096], len(edge_key), _pair_cost(copies, i[lo:lo + 4096], j[lo:lo + 4096],
-                                                                        variance))
+        _Groups.of(edge[lo:lo + 4096], len(edge_key)).add_into(v, _pair_cost(copies, i[lo:lo + 4096],
+                                                                            j[lo:lo + 4096], variance))
     src, dst = edge_key // nb, edge_key % nb
     # directed edges: e and e + E are the two directions of one pair
     tail, head = np.concatenate([src, dst]), np.concatenate([dst, src])

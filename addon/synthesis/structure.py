@@ -1,11 +1,12 @@
 """Structure first: a hole on a tiled or planked plane composed from shifted copies of the
 visible floor, so that its lines run on in phase, with the seam at the hole's border blended.
 
-The texture's own repeats (`translations`) and shifts along the floor's axes are the labels of
-a shift map (`shift_map`); the step left between the copies and the known pixels along the
-border is taken to zero by a membrane over the hole (the gradient-domain blend of Poisson
-image editing, whose guidance field is the copies' own gradients), which also keeps the fill's
-mean on its surroundings where the copies came from darker or lighter tiles. A stochastic
+The labels of a shift map (`shift_map`) are a tiling's repeats (`translations`), or, on planks
+that repeat along no second direction, those translations and shifts along the floor's axes.
+The step left between the copies and the known pixels along the border is taken to zero by a
+membrane over the hole (the gradient-domain blend of Poisson image editing, whose guidance
+field is the copies' own gradients), which also keeps the fill's mean on its surroundings where
+the copies came from darker or lighter tiles. A stochastic
 texture (carpet, concrete) has no dominant translation and matches itself along no axis:
 `structure_fill` returns None and the order-independent synthesis fills it alone.
 """
@@ -15,12 +16,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .shift_map import ShiftMap, candidate_shifts, lattice_shifts, shift_map
+from .shift_map import NEIGHBOURS4, ShiftMap, candidate_shifts, lattice_shifts, shift_map
 from .texture import CancelFn, ProgressFn, SynthesisParams, clip_outliers, fill, membrane
 from .translations import DOMINANT, Translations, dominant_translations, relative_difference
 
 _TRANSLATIONS = 8  # of the texture's repeats, the best this many are labels (time grows with labels^2)
-_STEPS = ((0, 1), (1, 0), (0, -1), (-1, 0))
 _PERIODS = 4  # grain repeating within this many synthesis neighbourhoods is left to the synthesis
 
 
@@ -105,7 +105,7 @@ def _border_mismatch(image: np.ndarray, known: np.ndarray, composed: ShiftMap) -
     total, count = np.zeros(image.shape, np.float32), np.zeros((h, w), np.float32)
     ys, xs = np.nonzero(composed.covered)
     t = composed.shifts[composed.labels[ys, xs]]
-    for dy, dx in _STEPS:
+    for dy, dx in NEIGHBOURS4:
         qy, qx = ys + dy, xs + dx
         sy, sx = qy + t[:, 0], qx + t[:, 1]
         ok = ((qy >= 0) & (qy < h) & (qx >= 0) & (qx < w) & (sy >= 0) & (sy < h) & (sx >= 0) & (sx < w))
