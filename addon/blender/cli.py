@@ -22,6 +22,7 @@ import tempfile
 import time
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ThreadPoolExecutor
+from dataclasses import replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -30,6 +31,7 @@ from .. import memory
 from ..callbacks import RunCallbacks
 from ..errors import DimredError
 from ..quality import DEFAULT_QUALITY, DESCRIPTIONS
+from . import batch_cli
 
 if TYPE_CHECKING:
     from ..removal import RemovalResult
@@ -142,7 +144,9 @@ def build_parser(*, blend_already_loaded: bool) -> argparse.ArgumentParser:
     )
     commands = parser.add_subparsers(title="commands", dest="command", required=True, metavar="COMMAND")
     remove = _command(commands, "remove", "remove an object from the panorama", _DESCRIPTION)
-    _scene_arguments(remove, blend_already_loaded, "the mesh object to remove")
+    _scene_arguments(remove, blend_already_loaded,
+                     "the mesh object to remove (repeatable: several are removed in this order, each from the "
+                     "panorama the ones before left, as in the add-on's panel)")
     remove.set_defaults(run=_remove)
     relocate = _command(commands, "relocate", "move an object elsewhere in the panorama (fixed-view constraint)",
                         _RELOCATE_DESCRIPTION)
@@ -158,6 +162,7 @@ def build_parser(*, blend_already_loaded: bool) -> argparse.ArgumentParser:
     _scene_arguments(align, blend_already_loaded, "the mesh object to align", removal=False)
     align.add_argument("--save", metavar="COPY.blend", help="write a copy of the .blend with the corrected object")
     align.set_defaults(run=_align)
+    batch_cli.add_commands(commands, formatter=argparse.RawDescriptionHelpFormatter)
     return parser
 
 
@@ -174,7 +179,7 @@ def _scene_arguments(parser: argparse.ArgumentParser, blend_already_loaded: bool
         parser.add_argument("blend", nargs="?", metavar="SCENE.blend", help=blend_help + " (default: the open file)")
     else:
         parser.add_argument("blend", metavar="SCENE.blend", help=blend_help)
-    parser.add_argument("--object", required=True, metavar="NAME", help=object_help)
+    parser.add_argument("--object", dest="objects", action="append", required=True, metavar="NAME", help=object_help)
     parser.add_argument("--fit-height", action="store_true",
                         help="align: fit the support's height instead of the object's scale (a proxy of known size)")
     if removal:
@@ -205,8 +210,47 @@ def _scene_arguments(parser: argparse.ArgumentParser, blend_already_loaded: bool
 def _remove(args: argparse.Namespace) -> int:
     from .. import pipeline
 
-    return _run(args, "removed", lambda scene, **options: pipeline.remove_object(
-        scene, args.object, align=args.align, fit_height=args.fit_height, **options))
+    def remove(scene: SceneData, name: str, **options) -> RemovalResult:
+        return pipeline.remove_object(scene, name, align=args.align, fit_height=args.fit_height, **options)
+
+    return _run(args, "removed", lambda scene, **options: _in_order(args, scene, remove, **options))
+
+
+def _in_order(args: argparse.Namespace, scene_data: SceneData, remove: Callable[..., RemovalResult],
+              **options) -> RemovalResult:
+    """The objects removed one after the other, as the panel composes removals: each from the
+    panorama plus the differences before it, with the objects removed before gone from the room.
+    The result is the sum of the differences; the report holds each removal's under "removals"."""
+    import bpy
+
+    from ..removal import RemovalResult
+    from . import reader
+
+    first, *rest = args.objects
+    result = remove(scene_data, first, **options)
+    if not rest:
+        return result
+    original, total, hidden = scene_data.hdri, result.difference, result.hidden_mask.copy()
+    reports = [result.report]
+    for count, name in enumerate(rest, start=1):
+        later = reader.read_scene(bpy.context.scene, center=args.center, exclude=args.objects[:count], defer_file=True)
+        later = replace(later, hdri=original + total)
+        step = remove(later, name, **options)
+        total += step.difference
+        hidden |= step.hidden_mask
+        reports.append(step.report)
+        del later, step
+    seconds: dict[str, float] = {}
+    for report in reports:
+        for stage, value in report.get("seconds", {}).items():
+            seconds[stage] = round(seconds.get(stage, 0.0) + value, 4)
+    report = {"objects": list(args.objects), "removals": reports, "seconds": seconds,
+              "image_size": reports[0].get("image_size"),
+              "hidden_pixels": sum(r.get("hidden_pixels", 0) for r in reports),
+              "hidden_region_filled": all(r.get("hidden_region_filled", True) for r in reports),
+              "warnings": [f"{n}: {w}" for n, r in zip(args.objects, reports, strict=True)
+                           for w in r.get("warnings", [])]}
+    return RemovalResult(difference=total, hidden_mask=hidden, report=report, hdri=original, seen=result.seen)
 
 
 def _relocate(args: argparse.Namespace) -> int:
@@ -217,7 +261,13 @@ def _relocate(args: argparse.Namespace) -> int:
     # Before the scene is read: a request no placement satisfies needs no .blend.
     check_move(move)
     return _run(args, "moved", lambda scene, **options: pipeline.relocate_object(
-        scene, args.object, move, align=args.align, fit_height=args.fit_height, **options))
+        scene, _single(args), move, align=args.align, fit_height=args.fit_height, **options))
+
+
+def _single(args: argparse.Namespace) -> str:
+    if len(args.objects) != 1:
+        raise DimredError(f"{args.command} takes one --object, not {len(args.objects)}")
+    return args.objects[0]
 
 
 def _align(args: argparse.Namespace) -> int:
@@ -233,9 +283,10 @@ def _align(args: argparse.Namespace) -> int:
     save = os.path.abspath(args.save) if args.save else None
     if save and os.path.abspath(bpy.data.filepath) == save:
         raise DimredError("--save must name a copy, not the .blend that is open")
-    alignment = pipeline.align_to_photo(scene_data, args.object, quality=args.quality, fit_height=args.fit_height)
-    moved = alignment.moved(scene_data, scene_data.object_index(args.object))
-    seen = pipeline.photographed_object(moved, args.object, quality=args.quality)
+    name = _single(args)
+    alignment = pipeline.align_to_photo(scene_data, name, quality=args.quality, fit_height=args.fit_height)
+    moved = alignment.moved(scene_data, scene_data.object_index(name))
+    seen = pipeline.photographed_object(moved, name, quality=args.quality)
     report = {"alignment": alignment.summary(), "segmentation": seen.summary() if seen else None,
               "seconds": {"alignment": round(alignment.seconds, 4),
                           "total": round(time.perf_counter() - started, 4)}}
@@ -247,7 +298,7 @@ def _align(args: argparse.Namespace) -> int:
         print(f"{PROG}: {alignment.message}", file=sys.stderr, flush=True)
         return 1
     if save:
-        obj = bpy.context.scene.objects[args.object]
+        obj = bpy.context.scene.objects[name]
         obj.matrix_world = Matrix(alignment.matrix.tolist()) @ obj.matrix_world
         try:
             bpy.ops.wm.save_as_mainfile(filepath=save, copy=True)
@@ -281,7 +332,7 @@ def _run(args: argparse.Namespace, done: str, compute: Callable[..., object]) ->
     report["seconds"] = seconds
     write_outputs(out, result, report)
     total = time.perf_counter() - started
-    print(f"{PROG}: {done} '{args.object}' in {total:.1f} s; wrote {out}", flush=True)
+    print(f"{PROG}: {done} {', '.join(repr(n) for n in args.objects)} in {total:.1f} s; wrote {out}", flush=True)
     for warning in report.get("warnings", []):
         print(f"{PROG}: warning: {warning}", file=sys.stderr)
     return 0
@@ -306,9 +357,14 @@ def _read(args: argparse.Namespace) -> SceneData:
     elif not bpy.data.filepath:
         raise DimredError("no .blend file is open: pass SCENE.blend")
     scene = bpy.context.scene
-    reader.check_object(scene, args.object)
+    if args.command != "remove":
+        _single(args)
+    if len(set(args.objects)) != len(args.objects):
+        raise DimredError("an --object is named twice")
+    for name in args.objects:
+        reader.check_object(scene, name)
     for plane in args.plane:
-        if plane == args.object:
+        if plane in args.objects:
             raise DimredError(f"'{plane}' is the object itself; it cannot also be a --plane")
         reader.check_object(scene, plane, purpose="used as a --plane")
     # Before the pixels are read: a run that cannot fit is refused now, not killed halfway.

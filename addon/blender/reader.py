@@ -94,6 +94,14 @@ def panorama_size(scene: bpy.types.Scene) -> tuple[int, int]:
     return _loaded_size(image, path)
 
 
+def panorama_file(scene: bpy.types.Scene) -> str:
+    """The file the panorama is read from; "" when its pixels are in the .blend (packed or
+    generated): what a batch hashes besides the .blend to tell whether a job's input changed."""
+    image = environment_texture(scene).image
+    path = _image_path(image)
+    return "" if image.packed_file is not None else path
+
+
 def environment_texture(scene: bpy.types.Scene) -> bpy.types.ShaderNodeTexEnvironment:
     """The Environment Texture node whose image the active World Output shows.
 
