@@ -50,11 +50,12 @@ class BatchResult:
         return sum(r.status != "done" for r in self.records)
 
 
-def run_batch(jobs_file: str, settings: BatchSettings, *, stream: TextIO = sys.stderr,
+def run_batch(jobs_file: str, settings: BatchSettings, *, stream: TextIO | None = None,
               inspect: Callable[[Sequence[str], Launcher], dict[str, Inspection]] = inspect_scenes,
               available: Callable[[], int | None] = memory.available_bytes) -> BatchResult:
     """Run every job of `jobs_file` into `settings.out`; DimredError (nothing written) when the
     jobs file or the settings are bad."""
+    stream = sys.stderr if stream is None else stream
     jobs = read_jobs(jobs_file)
     if settings.workers < 1:
         raise DimredError(f"--workers must be at least 1, not {settings.workers}")
@@ -67,6 +68,9 @@ def run_batch(jobs_file: str, settings: BatchSettings, *, stream: TextIO = sys.s
     if settings.scheduler is not None and not settings.use_dask:
         raise DimredError("--scheduler needs Dask, which Blender's Python does not have: run "
                           "`python -m addon.cli batch` from the project's environment")
+    if settings.scheduler is not None:
+        cluster.check_address(settings.scheduler, settings.tls,
+                              warn=lambda message: print(f"dimred: warning: {message}", file=stream))
     os.makedirs(out, exist_ok=True)
     execute.remove_leftovers(out)
     started = time.time()
@@ -110,7 +114,7 @@ def run_batch(jobs_file: str, settings: BatchSettings, *, stream: TextIO = sys.s
     try:
         if tasks and dask:
             cluster.run_dask(tasks, needs, scheduler=settings.scheduler, workers=workers, tls=settings.tls,
-                             on_done=done, warn=lambda message: print(f"dimred: warning: {message}", file=stream))
+                             on_done=done)
         elif tasks:
             run_local(tasks, needs, workers=workers, budget=budget, on_done=done)
     finally:

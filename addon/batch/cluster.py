@@ -40,10 +40,10 @@ def dask_available() -> bool:
 
 
 def run_dask(tasks: Sequence[Task], needs: Sequence[int], *, scheduler: str | None, workers: int,
-             tls: TLSFiles | None, on_done: Callable[[Record], None], warn: Callable[[str], None]) -> None:
+             tls: TLSFiles | None, on_done: Callable[[Record], None]) -> None:
     """Run `tasks` on a local cluster of `workers` single-threaded processes listening on
-    127.0.0.1 only (`scheduler` None) or on the cluster at `scheduler`; `on_done` gets each
-    record as it comes back, on the calling thread."""
+    127.0.0.1 only (`scheduler` None) or on the cluster at `scheduler` (its address checked by
+    `check_address` first); `on_done` gets each record as it comes back, on the calling thread."""
     try:
         from distributed import Client, LocalCluster, as_completed
         from distributed.security import Security
@@ -52,8 +52,6 @@ def run_dask(tasks: Sequence[Task], needs: Sequence[int], *, scheduler: str | No
                           "--scheduler (jobs then run as local processes)") from None
     security = None if tls is None else Security(tls_ca_file=tls.ca_file, tls_client_cert=tls.cert,
                                                   tls_client_key=tls.key, require_encryption=True)
-    if scheduler is not None:
-        _check_address(scheduler, tls, warn)
     cluster = None
     try:
         if scheduler is None:
@@ -96,7 +94,9 @@ def _memory_declared(client) -> bool:
     return bool(workers) and all(MEMORY_RESOURCE in w.get("resources", {}) for w in workers.values())
 
 
-def _check_address(address: str, tls: TLSFiles | None, warn: Callable[[str], None]) -> None:
+def check_address(address: str, tls: TLSFiles | None, *, warn: Callable[[str], None]) -> None:
+    """DimredError for an address the batch cannot or should not use; `warn` about one reached
+    unencrypted over the network."""
     parsed = urllib.parse.urlparse(address)
     if parsed.scheme not in ("tcp", "tls") or not parsed.hostname:
         raise DimredError(f"--scheduler {address}: give tcp://HOST:PORT or tls://HOST:PORT")

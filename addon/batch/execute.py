@@ -124,11 +124,14 @@ def _run_child(command: list[str], env: dict[str, str], log, timeout: float | No
     or when `cancel` is set."""
     process = subprocess.Popen(command, env=env, stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT)
     deadline = None if timeout is None else time.monotonic() + timeout
-    status = "done"
+    status, high_water = "done", None
+    arguments = "\0".join(command[1:]).encode()
     while True:
-        returncode, peak = _reap(process)
+        returncode, usage_peak = _reap(process)
         if returncode is not None:
-            return status, returncode, peak
+            on_linux = os.path.isdir("/proc/self")
+            return status, returncode, high_water if on_linux else usage_peak
+        high_water = _high_water(process.pid, arguments, high_water)
         if status == "done" and cancel is not None and cancel.is_set():
             status = "cancelled"
             process.kill()
@@ -138,9 +141,29 @@ def _run_child(command: list[str], env: dict[str, str], log, timeout: float | No
         time.sleep(_POLL_SECONDS)
 
 
+def _high_water(pid: int, arguments: bytes, so_far: float | None) -> float | None:
+    """The child's peak resident memory in MB as Linux keeps it for the program it runs
+    (VmHWM), once it runs it (its command line ends with `arguments`, whatever interpreter a
+    script's #! line put before them). A child's rusage would count the
+    batch process's own memory too, which the child holds between fork and exec; a child that
+    ends before its first reading has no figure (None) rather than that one."""
+    try:
+        with open(f"/proc/{pid}/cmdline", "rb") as handle:
+            if not handle.read().rstrip(b"\0").endswith(arguments):
+                return so_far
+        with open(f"/proc/{pid}/status", encoding="ascii") as lines:
+            for line in lines:
+                if line.startswith("VmHWM:"):
+                    megabytes = round(int(line.split()[1]) * 1024 / 1e6, 1)
+                    return megabytes if so_far is None else max(so_far, megabytes)
+    except (OSError, ValueError, IndexError):
+        pass
+    return so_far
+
+
 def _reap(process: subprocess.Popen) -> tuple[int | None, float | None]:
-    """(return code, peak memory in MB) once the child has exited, else (None, None). Where the
-    system reports a child's resource use (wait4), its peak resident memory comes with it."""
+    """(return code, peak memory in MB) once the child has exited, else (None, None). The peak
+    is the child's rusage (wait4), where the system reports one; `_run_child` prefers /proc's."""
     if not hasattr(os, "wait4"):
         return process.poll(), None
     pid, status, usage = os.wait4(process.pid, os.WNOHANG)

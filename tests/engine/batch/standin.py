@@ -7,7 +7,7 @@ dimred inspect FILE...`) and behaves by the object's (or the file's) name, in mi
   Crash    kills itself (SIGKILL)
   Slow     sleeps a minute
   Nap      sleeps half a second, then does what Box does
-  Hog      holds 200 MB for a moment, then does what Box does
+  Hog      holds 200 MB for 0.3 s, then does what Box does
 
 Every call appends its arguments to the file FAKE_DIMRED_LOG names. In `inspect`, a file named
 crash.blend kills the process and one named damaged.blend gets the reader's error.
@@ -54,6 +54,7 @@ if name == "Nap":
 if name == "Hog":
     hog = bytearray(200_000_000)
     hog[::4096] = b"x" * len(hog[::4096])
+    time.sleep(0.3)  # the batch reads the child's memory every 50 ms: a real job runs seconds
 os.makedirs(out, exist_ok=True)
 with open(os.path.join(out, "report.json"), "w") as handle:
     json.dump({"image_size": [16, 8], "seconds": {"total": 0.01}, "hidden_pixels": 5, "warnings": ["w"]}, handle)

@@ -1,0 +1,114 @@
+"""The batch of 20 ground-truth jobs (`scenes.batch`) through each engine: wall seconds, jobs a
+minute, the largest job's peak memory and the batch process's own, and a re-run's seconds.
+
+    .venv/bin/python benchmarks/bench_batch.py [--workers 2] [--check] [--markdown]
+
+Rows, each a fresh batch process measured from outside (its rusage): local processes (what
+`blender -c dimred batch` runs), a local Dask cluster (`python -m addon.cli batch`), the same
+batch run again into the Dask run's folder (every finished job kept: the cost of resuming), and
+one job after another (`--workers 1`, local processes), the base of the speed-up column. With
+--check, every good job's difference image is compared with the single command line's (16
+single runs more). The renders are the ground-truth cache's (rendered when missing). Timings on
+a shared machine are noisy: compare the rows of one run.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from scenes.batch import single, write_jobs_file
+from scenes.images import read_exr
+from scenes.render import REPO
+
+COLUMNS = ("engine", "workers", "seconds", "jobs/min", "speed-up", "done", "kept", "failed",
+           "largest job GB", "batch process GB")
+
+_RUN = """
+import sys
+from addon.batch.batch import BatchSettings, run_batch
+result = run_batch(sys.argv[1], BatchSettings(out=sys.argv[2], workers=int(sys.argv[3]),
+                                              use_dask=sys.argv[4] == "dask"))
+"""
+
+
+def _batch(jobs: Path, out: Path, workers: int, engine: str) -> dict:
+    """One batch in a fresh process: wall seconds, its peak memory and the summary's counts."""
+    started = time.perf_counter()
+    process = subprocess.Popen([sys.executable, "-c", _RUN, str(jobs), str(out), str(workers), engine], cwd=REPO,
+                               env={**os.environ, "PYTHONPATH": str(REPO)}, stderr=subprocess.DEVNULL)
+    _, status, usage = os.wait4(process.pid, 0)
+    seconds = time.perf_counter() - started
+    if os.waitstatus_to_exitcode(status) != 0:
+        raise SystemExit(f"bench_batch: the {engine} batch failed")
+    records = json.loads((out / "summary.json").read_text())["records"]
+    peaks = [r["peak_memory_mb"] for r in records if r["peak_memory_mb"] and not r["reused"]]
+    return {"seconds": seconds, "done": sum(r["status"] == "done" for r in records),
+            "kept": sum(r["reused"] for r in records), "failed": sum(r["status"] != "done" for r in records),
+            "largest": max(peaks) / 1e3 if peaks else None, "own": usage.ru_maxrss * 1024 / 1e9}
+
+
+def _check(jobs: list[dict], out: Path, folder: Path) -> tuple[int, list[str]]:
+    """How many good jobs' difference images equal the single command line's; the ones that differ."""
+    same, differ = 0, []
+    for job in jobs:
+        result = out / job["id"] / "difference.exr"
+        if not result.exists():
+            continue
+        run = single(job, folder / job["id"])
+        if run.returncode == 0 and np.array_equal(read_exr(result), read_exr(folder / job["id"] / "difference.exr")):
+            same += 1
+        else:
+            differ.append(job["id"])
+    return same, differ
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--check", action="store_true", help="compare every good job with the single command line")
+    parser.add_argument("--markdown", action="store_true")
+    args = parser.parse_args()
+    with tempfile.TemporaryDirectory(prefix="bench_batch-") as scratch:
+        folder = Path(scratch)
+        jobs_file, jobs = write_jobs_file(folder)
+        rows = [("processes", 1, _batch(jobs_file, folder / "serial", 1, "processes")),
+                ("processes", args.workers, _batch(jobs_file, folder / "processes", args.workers, "processes")),
+                ("dask-local", args.workers, _batch(jobs_file, folder / "dask", args.workers, "dask")),
+                ("dask-local, re-run", args.workers, _batch(jobs_file, folder / "dask", args.workers, "dask"))]
+        base = rows[0][2]["seconds"]
+        table = [COLUMNS]
+        for engine, workers, r in rows:
+            table.append((engine, str(workers), f"{r['seconds']:.1f}", f"{60 * len(jobs) / r['seconds']:.1f}",
+                          f"{base / r['seconds']:.2f}", str(r["done"]), str(r["kept"]), str(r["failed"]),
+                          "" if r["largest"] is None else f"{r['largest']:.2f}", f"{r['own']:.2f}"))
+        _print(table, markdown=args.markdown)
+        if args.check:
+            same, differ = _check(jobs, folder / "dask", folder / "single")
+            print(f"\n{same} good jobs' difference images equal the single command line's"
+                  + (f"; differ: {', '.join(differ)}" if differ else ""))
+
+
+def _print(table: list[tuple[str, ...]], *, markdown: bool) -> None:
+    if markdown:
+        print("| " + " | ".join(table[0]) + " |")
+        print("|" + "---|" * len(table[0]))
+        for row in table[1:]:
+            print("| " + " | ".join(row) + " |")
+        return
+    widths = [max(len(row[i]) for row in table) for i in range(len(table[0]))]
+    for row in table:
+        print("  ".join(cell.ljust(width) for cell, width in zip(row, widths, strict=True)))
+
+
+if __name__ == "__main__":
+    main()
