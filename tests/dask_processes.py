@@ -1,5 +1,6 @@
 """A real Dask cluster as a farm runs it: `dask scheduler` and `dask worker` processes started
-from the command line on localhost, the workers with this checkout on their Python path."""
+from the command line on localhost, the workers with this checkout on their Python path, over
+plain TCP or over TLS with certificates made by `openssl`."""
 from __future__ import annotations
 
 import contextlib
@@ -10,6 +11,8 @@ import sys
 from collections.abc import Iterator
 from pathlib import Path
 
+from addon.batch.cluster import TLSFiles
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -19,29 +22,50 @@ def _free_port() -> int:
         return probe.getsockname()[1]
 
 
+def make_certificates(folder: Path) -> TLSFiles:
+    """A certificate authority and one key and certificate it signed, for every member of a
+    test cluster (a farm would give each machine its own)."""
+    def openssl(*arguments: str) -> None:
+        subprocess.run(["openssl", *arguments], cwd=folder, check=True, capture_output=True, timeout=120)
+
+    openssl("req", "-x509", "-newkey", "rsa:2048", "-nodes", "-days", "2", "-subj", "/CN=dimred test CA",
+            "-keyout", "ca-key.pem", "-out", "ca.pem")
+    openssl("req", "-newkey", "rsa:2048", "-nodes", "-subj", "/CN=localhost", "-keyout", "key.pem", "-out", "req.pem")
+    openssl("x509", "-req", "-in", "req.pem", "-CA", "ca.pem", "-CAkey", "ca-key.pem", "-CAcreateserial", "-days", "2",
+            "-out", "cert.pem")
+    return TLSFiles(ca_file=str(folder / "ca.pem"), cert=str(folder / "cert.pem"), key=str(folder / "key.pem"))
+
+
 @contextlib.contextmanager
-def dask_cluster(workers: int, folder: Path, env: dict[str, str] | None = None) -> Iterator[str]:
+def dask_cluster(workers: int, folder: Path, env: dict[str, str] | None = None, *,
+                 tls: TLSFiles | None = None) -> Iterator[str]:
     """The address of a scheduler with `workers` single-threaded workers (one process each),
-    their logs in `folder`; all stopped on exit."""
+    their logs in `folder`, speaking TLS with `tls`'s certificates if given; all stopped on exit."""
     from distributed import Client
+    from distributed.security import Security
 
     environment = {**os.environ, **(env or {}),
                    "PYTHONPATH": os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))}
-    address = f"tcp://127.0.0.1:{_free_port()}"
+    port = str(_free_port())
+    address = f"{'tls' if tls else 'tcp'}://127.0.0.1:{port}"
+    certificates = [] if tls is None else ["--tls-ca-file", tls.ca_file, "--tls-cert", tls.cert, "--tls-key", tls.key]
     dask = [sys.executable, "-m", "dask"]
     processes = []
     try:
         with open(folder / "scheduler.log", "wb") as log:
+            protocol = ["--protocol", "tls"] if tls else []
             processes.append(subprocess.Popen(
-                [*dask, "scheduler", "--host", "127.0.0.1", "--port", address.rsplit(":", 1)[1], "--no-dashboard"],
-                env=environment, stdout=log, stderr=subprocess.STDOUT, cwd=folder))
+                [*dask, "scheduler", "--host", "127.0.0.1", "--port", port, "--no-dashboard", *protocol,
+                 *certificates], env=environment, stdout=log, stderr=subprocess.STDOUT, cwd=folder))
         for number in range(workers):
             with open(folder / f"worker-{number}.log", "wb") as log:
                 processes.append(subprocess.Popen(
                     [*dask, "worker", address, "--nworkers", "1", "--nthreads", "1", "--no-dashboard",
-                     "--name", f"farm-node-{number}", "--local-directory", str(folder / f"worker-{number}")],
-                    env=environment, stdout=log, stderr=subprocess.STDOUT, cwd=folder))
-        with Client(address, timeout="60s") as client:
+                     "--name", f"farm-node-{number}", "--local-directory", str(folder / f"worker-{number}"),
+                     *certificates], env=environment, stdout=log, stderr=subprocess.STDOUT, cwd=folder))
+        security = None if tls is None else Security(tls_ca_file=tls.ca_file, tls_client_cert=tls.cert,
+                                                      tls_client_key=tls.key, require_encryption=True)
+        with Client(address, timeout="60s", security=security) as client:
             client.wait_for_workers(workers, timeout=120)
         yield address
     finally:

@@ -4,6 +4,7 @@
     python -m addon.cli relocate SCENE.blend --object NAME --yaw DEG --distance-scale S --out DIR [options]
     python -m addon.cli align SCENE.blend --object NAME --out DIR [--save COPY.blend] [options]
     blender -b SCENE.blend -c dimred remove|relocate|align ... (the same arguments)
+    python -m addon.cli batch JOBS --out DIR ...  and  inspect SCENE.blend ... (`batch_cli`)
 
 Both run `run_cli`; inside Blender the .blend is already open, so SCENE.blend is optional.
 Bad input gets one line `dimred: error: ...` on stderr, exit code 2, and nothing on disk.

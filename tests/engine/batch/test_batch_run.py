@@ -7,6 +7,7 @@ from __future__ import annotations
 import csv
 import io
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -23,7 +24,7 @@ from addon.batch.execute import Record, pending
 from addon.batch.jobs import JobsFileError
 from addon.batch.progress import Progress
 from addon.errors import DimredError
-from tests.dask_processes import dask_cluster
+from tests.dask_processes import dask_cluster, make_certificates
 from tests.engine.batch.standin import calls, fake_launcher, summary, write_jobs
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -225,3 +226,20 @@ def test_dask_gives_the_same_outputs_as_local_processes(tmp_path, scenes, fake_b
     assert essentials(dask_local) == essentials(local_run) == essentials(farm)
     assert _outputs(tmp_path / "local") == _outputs(tmp_path / "dask") == _outputs(tmp_path / "farm")
     assert len(_outputs(tmp_path / "farm")) == 3
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(shutil.which("openssl") is None, reason="openssl makes the test's certificates")
+def test_a_scheduler_is_reached_over_tls_with_the_certificates(tmp_path, scenes, fake_blender):
+    jobs = write_jobs(tmp_path / "jobs.jsonl", _jobs(scenes)[:2])
+    certificates = tmp_path / "certificates"
+    certificates.mkdir()
+    tls = make_certificates(certificates)
+    env = {"FAKE_DIMRED_LOG": str(tmp_path / "calls.jsonl")}
+    with dask_cluster(2, tmp_path, env, tls=tls) as address:
+        assert address.startswith("tls://")
+        with pytest.raises(DimredError, match="needs --tls-ca-file"):
+            run_batch(str(jobs), _settings(tmp_path, fake_blender, use_dask=True, scheduler=address))
+        farm = run_batch(str(jobs), _settings(tmp_path, fake_blender, use_dask=True, scheduler=address, tls=tls),
+                         stream=io.StringIO())
+    assert farm.engine == "dask" and [r.status for r in farm.records] == ["done", "done"]
