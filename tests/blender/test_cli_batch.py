@@ -22,17 +22,19 @@ pytestmark = pytest.mark.usefixtures("fresh_blender")
 
 @pytest.fixture
 def room(tmp_path):
+    """The command line tests' room: floor, box, lamp, camera, lit by HDRI, saved as room.blend."""
     return _save_scene(tmp_path)
 
 
-@pytest.fixture
-def engine(monkeypatch):
+def _stand_in_engine(monkeypatch) -> FakeEngine:
     fake = FakeEngine()
     monkeypatch.setattr(pipeline, "remove_object", fake)
     return fake
 
 
-def test_several_objects_are_removed_in_order_each_from_what_the_ones_before_left(room, engine, tmp_path, capfd):
+def test_several_objects_are_removed_in_order_each_from_what_the_ones_before_left(room, monkeypatch, tmp_path,
+                                                                                  capfd):
+    engine = _stand_in_engine(monkeypatch)
     bpy.ops.wm.open_mainfile(filepath=str(room))
     _plane("Rug", 0.8, 0.01)
     bpy.ops.wm.save_mainfile()
@@ -60,7 +62,8 @@ def test_several_objects_are_removed_in_order_each_from_what_the_ones_before_lef
     (["--object", "Box", "--object", "Box"], "an --object is named twice"),
     (["--object", "Box", "--object", "Chair"], "no object named 'Chair'"),
 ])
-def test_several_objects_are_checked_before_any_work(room, engine, tmp_path, capfd, arguments, expected):
+def test_several_objects_are_checked_before_any_work(room, monkeypatch, tmp_path, capfd, arguments, expected):
+    engine = _stand_in_engine(monkeypatch)
     out = tmp_path / "result"
     assert cli.main(["remove", str(room), *arguments, "--out", str(out)]) == 2
     assert expected in capfd.readouterr().err and not engine.calls and not out.exists()
