@@ -3,7 +3,9 @@ on and off, through the engine as the command line runs it (balanced, exact prox
     .venv/bin/python benchmarks/bench_fill_groundtruth.py [--scenes a,b] [--width 1024]
 Prints a markdown table: structure (`scenes.metrics.structure_correlation` over the object's
 pixels), detail ratio, mean ratio and object + shadow error (`hidden_region_scores`), NaNs,
-and the seconds the fill of the revealed surfaces took (`filled_surfaces` in the report).
+the seconds the fill of the revealed surfaces took (`filled_surfaces` in the report), and the
+report's stages `synthesis` (that fill and its previews) and `hidden_light` (the irradiance
+after the removal at the revealed pixels).
 Renders are cached (scenes.render); the first run renders what is missing (minutes each).
 """
 from __future__ import annotations
@@ -36,8 +38,9 @@ def main() -> None:
 
     print(f"{args.width}x{args.width // 2}, balanced, exact proxies")
     print()
-    print("| scene | floor | structure-aware | structure | detail | mean | object + shadow | NaN | fill s |")
-    print("|---|---|---|---|---|---|---|---|---|")
+    print("| scene | floor | structure-aware | structure | detail | mean | object + shadow | NaN | fill s "
+          "| synthesis s | hidden light s |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
     for name in args.scenes.split(","):
         s = spec.get(name)
         s = s.with_render(width=args.width, height=args.width // 2, samples=32 if name == "demo" else args.samples)
@@ -52,7 +55,8 @@ def main() -> None:
             fill_s = sum(f["seconds"] for f in r.report["filled_surfaces"])
             print(f"| {name} | {s.room.floor.pattern} | {'on' if structure else 'off'} | {h['structure']:.3f} "
                   f"| {h['detail_ratio']:.2f} | {h['mean_ratio']:.3f} | {h['object_shadow_ratio']:.3f} "
-                  f"| {int(np.isnan(edit).sum())} | {fill_s:.2f} |", flush=True)
+                  f"| {int(np.isnan(edit).sum())} | {fill_s:.2f} | {r.report['seconds']['synthesis']:.2f} "
+                  f"| {r.report['seconds']['hidden_light']:.2f} |", flush=True)
 
 
 if __name__ == "__main__":

@@ -117,7 +117,7 @@ def _relocated(scene: SceneData, object_name: str, move: Move, target: int, plan
         # less time, on four scenes).
         step_params = params if k == passes - 1 else rough(params)
         moved = replace(moved_scene, hdri=current.reshape(photo.shape).astype(np.float32))
-        step = Report(step_callbacks.progress, stages=STAGES - 1)
+        step = Report(step_callbacks.progress, stages=STAGES - 2)  # nothing revealed: no hidden light, no synthesis
         geo, moved_target, traced = traced_scene(moved, object_name, planes, step_params, step, step_callbacks,
                                                  fill=False)
         hdri = moved.hdri

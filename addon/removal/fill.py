@@ -35,27 +35,50 @@ class Revealed:
     panorama: PanoramaReflectance  # the exemplar's source
 
 
-def fill_hidden(solution: Solution, revealed: Revealed, rep: Report, callbacks: RunCallbacks,
-                show: Callable[[np.ndarray], None] | None = None) -> np.ndarray:
-    """(K, 3) radiance change of the revealed pixels: synthesised reflectance lit by the
-    irradiance after removal.
+@dataclass(frozen=True)
+class HiddenLight:
+    """The revealed pixels' light once the object is gone, and what they show before any
+    texture: their patches' mean reflectance, or the radiosity of a light behind the object."""
 
-    `show(change)` gets the revealed pixels' change as the fill refines: first with each
-    patch's mean reflectance, then after every synthesis level of every surface."""
+    e_after: np.ndarray  # (K, 3) irradiance after the removal
+    rho: np.ndarray  # (K, 3) their patches' mean reflectance
+    emit: np.ndarray  # (K,) bool: the pixel sees a light
+    emitted: np.ndarray  # (K, 3) that light's radiance (its patch's radiosity / pi)
+
+    def change(self, rho: np.ndarray, radiance: np.ndarray) -> np.ndarray:
+        """(K, 3) the radiance change of reflectance `rho` lit by E' against `radiance`."""
+        new = rho * self.e_after / np.pi
+        new[self.emit] = self.emitted[self.emit]
+        return new - radiance
+
+
+def hidden_light(solution: Solution, revealed: Revealed, callbacks: RunCallbacks) -> HiddenLight:
+    """The irradiance after the removal at the revealed pixels (light transport: the report's
+    stage `hidden_light`, apart from the synthesis that `fill_hidden` adds to it)."""
     geo, room = solution.geo, solution.room
     fine = fine_light(geo, solution.target, room, solution.occlusion, solution.db, solution.split, revealed.tri,
                       revealed.bary, callbacks)
     patch, _, _ = room.patches.lattice.locate(revealed.tri, revealed.bary)
-    e_after = np.maximum(interpolate(fine.e_after, fine.corners, fine.weights), 0.0)
-    b = room.senders.radiosity
-    rho = room.rho[patch].copy()
     emit = room.emitter[patch]
+    emitted = np.zeros((len(patch), 3))
+    # A light behind the object shines on with the radiosity its patch was given.
+    emitted[emit] = room.senders.radiosity[patch[emit]] / np.pi
+    return HiddenLight(e_after=np.maximum(interpolate(fine.e_after, fine.corners, fine.weights), 0.0),
+                       rho=room.rho[patch], emit=emit, emitted=emitted)
+
+
+def fill_hidden(solution: Solution, revealed: Revealed, light: HiddenLight, rep: Report, callbacks: RunCallbacks,
+                show: Callable[[np.ndarray], None] | None = None) -> np.ndarray:
+    """(K, 3) radiance change of the revealed pixels: synthesised reflectance lit by the
+    irradiance after removal (`light`).
+
+    `show(change)` gets the revealed pixels' change as the fill refines: first with each
+    patch's mean reflectance, then after every synthesis level of every surface."""
+    geo = solution.geo
+    rho = light.rho.copy()
 
     def change() -> np.ndarray:
-        new = rho * e_after / np.pi
-        # A light behind the object shines on with the radiosity its patch was given.
-        new[emit] = b[patch[emit]] / np.pi
-        return new - revealed.radiance
+        return light.change(rho, revealed.radiance)
 
     if show is not None:
         show(change())

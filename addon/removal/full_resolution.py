@@ -22,7 +22,7 @@ from ..radiance import clamped_rows
 from ..report import Report
 from ..synthesis.plane_fill import PanoramaMaps, PanoramaReflectance
 from .compose import ratio_change, reference_irradiance
-from .fill import Revealed, fill_hidden, hidden_planes, measured_reflectance, surface_footprint
+from .fill import Revealed, fill_hidden, hidden_light, hidden_planes, measured_reflectance, surface_footprint
 from .local import Receiving, light_at
 from .object_window import ObjectWindow, object_window
 from .solution import Solution
@@ -81,9 +81,11 @@ def full_resolution(solution: Solution, hdri: np.ndarray, rep: Report, callbacks
     hidden_mask[rows, cols] = window.hidden
     revealed = window.hidden & (window.tri >= 0)
     if revealed.any():
-        with rep.stage("synthesis"):
+        with rep.stage("hidden_light"):
             found = _revealed(solution, window, window_e, hdri, revealed, e_ref)
-            change = fill_hidden(solution, found, rep, callbacks)
+            light = hidden_light(solution, found, callbacks)
+        with rep.stage("synthesis"):
+            change = fill_hidden(solution, found, light, rep, callbacks)
             difference[rows[revealed], cols[revealed]] = change
     else:
         rep.skip("synthesis", "nothing is behind the object to fill")

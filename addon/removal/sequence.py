@@ -23,7 +23,7 @@ from ..scene import SceneData
 from ..segmentation.seen import SeenObject, seen_object
 from ..segmentation.user_mask import UserMask
 from .compose import compose
-from .fill import fill_hidden, working_revealed
+from .fill import fill_hidden, hidden_light, working_revealed
 from .first_order import first_order
 from .full_resolution import full_resolution
 from .local import local_light
@@ -35,7 +35,7 @@ from .target import Target, object_index, prepare
 from .trace import Traced, trace
 from .working import downsample, working_size
 
-STAGES = 9  # the stages a removal reports progress for
+STAGES = 10  # the stages a removal reports progress for
 
 
 @dataclass(frozen=True)
@@ -132,8 +132,11 @@ def finish(solution: Solution, rep: Report, callbacks: RunCallbacks = NO_CALLBAC
 
     if len(revealed):
         show = None if callbacks.preview is None else lambda d_revealed: callbacks.show(difference_image(d_revealed))
+        with rep.stage("hidden_light"):
+            found = working_revealed(solution)
+            light = hidden_light(solution, found, callbacks)
         with rep.stage("synthesis"):
-            d_revealed = fill_hidden(solution, working_revealed(solution), rep, callbacks, show)
+            d_revealed = fill_hidden(solution, found, light, rep, callbacks, show)
     else:
         d_revealed = np.zeros((0, 3))
         rep.skip("synthesis", "the object is not visible from the probe centre: no hidden region to fill"

@@ -18,7 +18,7 @@ from addon.light.radiosity import LUMA, RHO_MAX
 from addon.quality import params_for
 from addon.removal import finish, solve_lighting
 from addon.removal.compose import compose
-from addon.removal.fill import fill_hidden, working_revealed
+from addon.removal.fill import fill_hidden, hidden_light, working_revealed
 from addon.removal.first_order import first_order
 from addon.removal.local import local_light
 from addon.removal.occlusion import occluders
@@ -187,7 +187,9 @@ def test_compose_changes_only_pixels_that_keep_their_surface(stages):
 def test_fill_gives_the_revealed_floor_positive_light_and_shows_its_progress(stages):
     solution = stages["solution"]
     shown: list[np.ndarray] = []
-    change = fill_hidden(solution, working_revealed(solution), Report(), NO_CALLBACKS, shown.append)
+    revealed_pixels = working_revealed(solution)
+    light = hidden_light(solution, revealed_pixels, NO_CALLBACKS)
+    change = fill_hidden(solution, revealed_pixels, light, Report(), NO_CALLBACKS, shown.append)
     revealed = solution.traced.behind.revealed
     assert change.shape == (len(revealed), 3) and np.isfinite(change).all()
     filled = solution.traced.panorama_rows(solution.hdri)[revealed] + change
