@@ -38,14 +38,17 @@ def make_certificates(folder: Path) -> TLSFiles:
 
 @contextlib.contextmanager
 def dask_cluster(workers: int, folder: Path, env: dict[str, str] | None = None, *,
-                 tls: TLSFiles | None = None) -> Iterator[str]:
+                 tls: TLSFiles | None = None, project_on_path: bool = True) -> Iterator[str]:
     """The address of a scheduler with `workers` single-threaded workers (one process each),
-    their logs in `folder`, speaking TLS with `tls`'s certificates if given; all stopped on exit."""
+    their logs in `folder`, speaking TLS with `tls`'s certificates if given, the checkout on
+    their Python path unless not `project_on_path`; all stopped on exit."""
     from distributed import Client
     from distributed.security import Security
 
-    environment = {**os.environ, **(env or {}),
-                   "PYTHONPATH": os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))}
+    environment = {key: value for key, value in os.environ.items() if key != "PYTHONPATH"}
+    environment.update(env or {})
+    if project_on_path:
+        environment["PYTHONPATH"] = os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))
     port = str(_free_port())
     address = f"{'tls' if tls else 'tcp'}://127.0.0.1:{port}"
     certificates = [] if tls is None else ["--tls-ca-file", tls.ca_file, "--tls-cert", tls.cert, "--tls-key", tls.key]

@@ -63,6 +63,7 @@ def run_dask(tasks: Sequence[Task], needs: Sequence[int], *, scheduler: str | No
             cluster.close()
         raise DimredError(f"cannot reach the Dask scheduler {scheduler or '(local)'}: {error}") from None
     try:
+        _check_workers_import(client)
         declared = _memory_declared(client)
         futures = {}
         for task, need in zip(tasks, needs, strict=True):
@@ -85,6 +86,21 @@ def run_dask(tasks: Sequence[Task], needs: Sequence[int], *, scheduler: str | No
         client.close()
         if cluster is not None:
             cluster.close()
+
+
+def _check_workers_import(client) -> None:
+    """DimredError unless every worker can import the job runner: a task it cannot unpickle
+    would only be retried on the next worker, and the batch would wait for ever."""
+    import pkgutil
+
+    target = f"{run_job.__module__}:{run_job.__name__}"
+    try:
+        # pkgutil.resolve_name is the standard library's (importable on any worker) and returns
+        # something a worker can send back: the function, pickled by reference.
+        client.run(pkgutil.resolve_name, target)
+    except Exception as error:
+        raise DimredError(f"the Dask workers cannot import {run_job.__module__} ({type(error).__name__}: {error}): "
+                          "start them from this project's environment with the checkout on PYTHONPATH") from None
 
 
 def _memory_declared(client) -> bool:

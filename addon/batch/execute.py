@@ -47,12 +47,14 @@ class Launcher:
 
     @staticmethod
     def python_command() -> tuple[list[str], dict[str, str]]:
-        """`python -m addon.cli` of this interpreter, the project on its path, and its environment."""
+        """`python -m addon.cli` of this interpreter with the folder holding the engine's package
+        on its path (a checkout, or an installed extension, where the package sits below
+        `bl_ext.<repository>`: the engine imports nothing outside it), and its environment."""
         env = dict(os.environ)
-        package = __name__.split(".")[0]
-        root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+        package = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+        root = os.path.dirname(package)
         env["PYTHONPATH"] = os.pathsep.join(p for p in (root, env.get("PYTHONPATH", "")) if p)
-        return [sys.executable, "-m", f"{package}.cli"], env
+        return [sys.executable, "-m", f"{os.path.basename(package)}.cli"], env
 
 
 @dataclass(frozen=True)

@@ -51,7 +51,11 @@ examples:
 MAX_FAILED_STATUS = 100
 
 
-def add_commands(commands: argparse._SubParsersAction, *, formatter: type[argparse.HelpFormatter]) -> None:
+def add_commands(commands: argparse._SubParsersAction, *, formatter: type[argparse.HelpFormatter],
+                 inside_blender: bool) -> None:
+    """The `batch` and `inspect` subcommands; `inside_blender` (`blender -c dimred`): the jobs
+    run as local processes, never on Dask (the extension does not ship it, and a Dask worker
+    could not import the installed extension's package)."""
     batch = commands.add_parser("batch", help="run a file of jobs, resumable, on local processes or a Dask cluster",
                                 description=_BATCH_DESCRIPTION, epilog=_BATCH_EPILOG, formatter_class=formatter)
     batch.add_argument("jobs", metavar="JOBS", help="the jobs file (.jsonl, or .csv with a header)")
@@ -65,7 +69,7 @@ def add_commands(commands: argparse._SubParsersAction, *, formatter: type[argpar
     batch.add_argument("--tls-ca-file", metavar="FILE", help="the certificate authority of the cluster's certificates")
     batch.add_argument("--tls-cert", metavar="FILE", help="this client's certificate")
     batch.add_argument("--tls-key", metavar="FILE", help="this client's private key")
-    batch.set_defaults(run=_batch)
+    batch.set_defaults(run=_batch, inside_blender=inside_blender)
     inspect = commands.add_parser(
         "inspect", help="print each scene's panorama size and the files it reads (JSON lines)",
         description="Print one JSON line per scene: {\"blend\", \"size\": [width, height], \"files\": [the "
@@ -87,10 +91,9 @@ def _batch(args: argparse.Namespace) -> int:
     for path in filter(None, tls_files):
         if not os.path.isfile(path):
             raise DimredError(f"no such file: {path}")
-    blender = _blender_executable()
     settings = BatchSettings(out=args.out, workers=args.workers, scheduler=args.scheduler, timeout=args.timeout,
                              tls=TLSFiles(*tls_files) if all(tls_files) else None,
-                             launcher=Launcher(blender=blender), use_dask=not blender)
+                             launcher=Launcher(blender=_blender_executable()), use_dask=not args.inside_blender)
     try:
         result = run_batch(args.jobs, settings)
     except JobsFileError as error:

@@ -163,7 +163,8 @@ def build_parser(*, blend_already_loaded: bool) -> argparse.ArgumentParser:
     _scene_arguments(align, blend_already_loaded, "the mesh object to align", removal=False)
     align.add_argument("--save", metavar="COPY.blend", help="write a copy of the .blend with the corrected object")
     align.set_defaults(run=_align)
-    batch_cli.add_commands(commands, formatter=argparse.RawDescriptionHelpFormatter)
+    batch_cli.add_commands(commands, formatter=argparse.RawDescriptionHelpFormatter,
+                           inside_blender=blend_already_loaded)
     return parser
 
 

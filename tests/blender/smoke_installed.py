@@ -116,6 +116,23 @@ def command_run(command: Callable[[list[str]], int], work: Path, hdri_path: Path
     check_outputs(out, hdri_path)
 
 
+def batch_run(command: Callable[[list[str]], int], blend: Path, work: Path, hdri_path: Path) -> None:
+    """`blender -c dimred batch` from the installed package: the job in its own process (this
+    Python with the installed engine on its path), its folder whole, kept when run again."""
+    jobs = work / "jobs.jsonl"
+    job = {"id": "room", "blend": str(blend), "op": "remove", "object": "Box",
+           "params": {"quality": "draft", "center": list(tiny_scene.CENTER)}}
+    jobs.write_text(json.dumps(job) + "\n", encoding="utf-8")
+    out = work / "batch"
+    for run in ("first", "again"):
+        code = command(["batch", str(jobs), "--out", str(out), "--workers", "1"])
+        summary = json.loads((out / "summary.json").read_text())
+        [record] = summary["records"]
+        assert code == 0, f"{run} run: exit code {code}, {record['error']}"
+        assert record["status"] == "done" and record["reused"] == (run == "again"), record
+    check_outputs(out / "room", hdri_path)
+
+
 def operator_run(blend: Path, hdri_path: Path) -> None:
     import bpy
 
@@ -206,6 +223,8 @@ def main(argv: list[str]) -> int:
         command = step("blender_command importable from the installed package", command_function)
         blend, hdri_path = step("tiny scene opened", open_tiny_scene, work)
         step("blender -c dimred remove: files written and finite", command_run, command, work, hdri_path)
+        step("blender -c dimred batch: the job in its own process, kept when run again", batch_run, command, blend,
+             work, hdri_path)
         step("bpy.ops.dimred.remove, Cycles render of the world, undo, redo, clear", operator_run, blend, hdri_path)
         step("bpy.ops.dimred.relocate: the box moved and the layer written, clear puts it back", relocate_run, blend)
     except Exception:

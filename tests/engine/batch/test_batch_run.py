@@ -243,3 +243,17 @@ def test_a_scheduler_is_reached_over_tls_with_the_certificates(tmp_path, scenes,
         farm = run_batch(str(jobs), _settings(tmp_path, fake_blender, use_dask=True, scheduler=address, tls=tls),
                          stream=io.StringIO())
     assert farm.engine == "dask" and [r.status for r in farm.records] == ["done", "done"]
+
+
+@pytest.mark.slow
+def test_workers_without_the_project_are_refused_at_once(tmp_path, scenes, fake_blender):
+    """A farm node started without the checkout on its Python path could not unpickle a job:
+    the batch says so before it submits anything, instead of waiting for ever."""
+    jobs = write_jobs(tmp_path / "jobs.jsonl", _jobs(scenes)[:1])
+    with dask_cluster(1, tmp_path, project_on_path=False) as address:
+        started = time.monotonic()
+        with pytest.raises(DimredError, match=r"workers cannot import addon\.batch\.execute"):
+            run_batch(str(jobs), _settings(tmp_path, fake_blender, use_dask=True, scheduler=address),
+                      stream=io.StringIO())
+    assert time.monotonic() - started < 60
+    assert all("inspect" in c for c in calls(tmp_path))  # no job was run
