@@ -25,7 +25,6 @@ from .jobs import Job
 #: The file in each job's folder that says what the job was and what it gave.
 MANIFEST = "job.json"
 LOGS = "logs"
-STATUSES = ("done", "failed", "timeout", "crashed", "cancelled", "pending")
 _POLL_SECONDS = 0.05
 
 
@@ -77,7 +76,7 @@ class Record:
     line: int
     op: str
     objects: tuple[str, ...]
-    status: str  # one of STATUSES
+    status: str  # done, failed, timeout, crashed (killed by a signal), cancelled (Ctrl-C) or pending
     reused: bool = False  # finished by an earlier run of the batch, its inputs unchanged
     seconds: float | None = None
     peak_memory_mb: float | None = None
