@@ -99,7 +99,11 @@ def run_batch(jobs_file: str, settings: BatchSettings, *, stream: TextIO | None 
             needs.append(need)
     budget = available()
     workers = _workers(settings.workers, needs, budget)
-    engine = "none" if not tasks else ("dask" if settings.scheduler else "dask-local") if dask else "processes"
+    engine = "processes"
+    if not tasks:
+        engine = "none"
+    elif dask:
+        engine = "dask" if settings.scheduler else "dask-local"
     progress = Progress(stream, total=len(jobs), workers=workers)
     for job in jobs:
         if records[job.id].status != "pending":

@@ -18,6 +18,7 @@ import subprocess
 import sys
 import threading
 import time
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field
 
 from .jobs import Job
@@ -43,6 +44,13 @@ class Launcher:
             return [self.blender, "-b", job.blend, "-c", "dimred", *arguments], dict(os.environ)
         command, env = self.python_command()
         return [*command, arguments[0], job.blend, *arguments[1:]], env
+
+    def inspect_command(self, blends: Sequence[str]) -> tuple[list[str], dict[str, str]]:
+        """The child's argument list and environment for `dimred inspect BLEND...`."""
+        if self.blender:
+            return [self.blender, "-b", "-c", "dimred", "inspect", *blends], dict(os.environ)
+        command, env = self.python_command()
+        return [*command, "inspect", *blends], env
 
     @staticmethod
     def python_command() -> tuple[list[str], dict[str, str]]:

@@ -4,7 +4,6 @@ that in a child process, so a .blend that crashes Blender costs that child, not 
 from __future__ import annotations
 
 import json
-import os
 import subprocess
 import sys
 from collections.abc import Sequence
@@ -21,21 +20,13 @@ class Inspection:
     error: str = ""  # why the scene cannot be run ("" when it can)
 
 
-def inspect_command(launcher: Launcher, blends: Sequence[str]) -> tuple[list[str], dict[str, str]]:
-    """The child's arguments and environment for `dimred inspect BLEND...`."""
-    if launcher.blender:
-        return [launcher.blender, "-b", "-c", "dimred", "inspect", *blends], dict(os.environ)
-    command, env = launcher.python_command()
-    return [*command, "inspect", *blends], env
-
-
 def inspect_scenes(blends: Sequence[str], launcher: Launcher, *, timeout: float = 600.0) -> dict[str, Inspection]:
     """The inspection of every .blend in `blends`. A child that dies on a file leaves that file
     with an error and the rest to a new child."""
     found: dict[str, Inspection] = {}
     left = list(dict.fromkeys(blends))
     while left:
-        command, env = inspect_command(launcher, left)
+        command, env = launcher.inspect_command(left)
         try:
             proc = subprocess.run(command, env=env, stdin=subprocess.DEVNULL, capture_output=True, text=True,
                                   timeout=timeout)

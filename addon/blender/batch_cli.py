@@ -120,6 +120,8 @@ def _blender_executable() -> str:
 
 
 def _inspect(args: argparse.Namespace) -> int:
+    import bpy
+
     from . import reader
     from .cli import open_blend
 
@@ -127,8 +129,6 @@ def _inspect(args: argparse.Namespace) -> int:
         path = os.path.abspath(blend)
         try:
             open_blend(path)
-            import bpy
-
             scene = bpy.context.scene
             size = reader.panorama_size(scene)
             record = {"blend": path, "size": list(size), "files": [f for f in [reader.panorama_file(scene)] if f]}
