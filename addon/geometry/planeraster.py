@@ -179,9 +179,12 @@ def sample_points(points: np.ndarray, image: np.ndarray, valid: np.ndarray, *, f
             weight += w
     if not cubic:
         return total / np.where(weight > 0.0, weight, 1.0)[..., None], weight
-    whole = np.abs(weight - 1.0) < 1e-6  # all 16 valid: the cubic weights sum to 1
-    plain, bilinear = sample_points(points, image, valid, frame=frame)
-    return np.where(whole[..., None], total, plain), bilinear
+    # all 16 valid (the cubic weights sum to 1), else bilinear over the valid ones of its 4
+    part = np.abs(weight - 1.0) >= 1e-6
+    bilinear = np.ones(u.shape)
+    if part.any():
+        total[part], bilinear[part] = sample_points(points[part], image, valid, frame=frame)
+    return total, bilinear
 
 
 def _bilinear(f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
