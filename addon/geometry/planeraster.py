@@ -153,12 +153,9 @@ def sample_panorama(raster: PlaneRaster, image: np.ndarray, valid: np.ndarray, *
     return sample_points(raster.points(), image, valid, frame=frame)
 
 
-def sample_points(points: np.ndarray, image: np.ndarray, valid: np.ndarray, *, frame: Frame | None = None,
-                  cubic: bool = False) -> tuple[np.ndarray, np.ndarray]:
-    """`sample_panorama` at any points (..., 3) in the probe frame: (..., C) and (...). With
-    `cubic`, points whose 4 x 4 pixels are all valid are interpolated by Keys' cubic convolution
-    (a = -1/2), which keeps detail that bilinear weights average away; the weight stays the
-    bilinear one."""
+def sample_points(points: np.ndarray, image: np.ndarray, valid: np.ndarray, *, frame: Frame | None = None
+                  ) -> tuple[np.ndarray, np.ndarray]:
+    """`sample_panorama` at any points (..., 3) in the probe frame: (..., C) and (...)."""
     frame = frame or Frame.whole(image.shape)
     u, v = latlong.direction_to_uv(points)
     x = u * frame.width - 0.5
@@ -167,34 +164,14 @@ def sample_points(points: np.ndarray, image: np.ndarray, valid: np.ndarray, *, f
     fx, fy = x - x0, y - y0
     total = np.zeros((*u.shape, image.shape[2]))
     weight = np.zeros(u.shape)
-    taps = (0, 1) if not cubic else (-1, 0, 1, 2)
-    wys, wxs = (_bilinear(fy), _bilinear(fx)) if not cubic else (_keys(fy), _keys(fx))
-    for dy, wy in zip(taps, wys, strict=True):
-        for dx, wx in zip(taps, wxs, strict=True):
-            rows = np.clip(y0.astype(np.int64) + dy, 0, frame.height - 1)
+    for dy, wy in ((0, 1.0 - fy), (1, fy)):
+        for dx, wx in ((0, 1.0 - fx), (1, fx)):
+            rows = np.minimum(y0.astype(np.int64) + dy, frame.height - 1)
             r, c, inside = frame.locate(rows, x0.astype(np.int64) + dx, image.shape)
-            ok = inside & valid[r, c]
-            w = wy * wx * ok
+            w = wy * wx * (inside & valid[r, c])
             total += w[..., None] * image[r, c]
             weight += w
-    if not cubic:
-        return total / np.where(weight > 0.0, weight, 1.0)[..., None], weight
-    # all 16 valid (the cubic weights sum to 1), else bilinear over the valid ones of its 4
-    part = np.abs(weight - 1.0) >= 1e-6
-    bilinear = np.ones(u.shape)
-    if part.any():
-        total[part], bilinear[part] = sample_points(points[part], image, valid, frame=frame)
-    return total, bilinear
-
-
-def _bilinear(f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    return 1.0 - f, f
-
-
-def _keys(f: np.ndarray) -> tuple[np.ndarray, ...]:
-    """Keys' cubic convolution weights (a = -1/2) of the taps at -1, 0, 1, 2 for offsets f."""
-    f2, f3 = f * f, f * f * f
-    return (-0.5 * f3 + f2 - 0.5 * f, 1.5 * f3 - 2.5 * f2 + 1.0, -1.5 * f3 + 2.0 * f2 + 0.5 * f, 0.5 * f3 - 0.5 * f2)
+    return total / np.where(weight > 0.0, weight, 1.0)[..., None], weight
 
 
 def sample_raster(raster: PlaneRaster, image: np.ndarray, points: np.ndarray) -> np.ndarray:

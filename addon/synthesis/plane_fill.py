@@ -149,12 +149,10 @@ def _copied(rho: np.ndarray, panorama: PanoramaReflectance, plane: HiddenPlane, 
     """The hidden points whose cell the shift map composed read their copy from the panorama
     itself, at the point moved by the cell's shift, plus the blend's smooth correction: one
     resampling of the photograph instead of two (panorama to raster to panorama), which kept
-    about 60 % of the fine detail. The copy is cubic, not bilinear: at 1024x512 that raised the
-    detail ratio from 0.68-0.81 to 0.84-0.93 on checker and plank floors for 0.01 of structure
-    (the copied render noise is independent of the truth's). Bilinear weights steepened towards
-    the nearest pixel copied the near floor's sharper grain into the blurred far floor at
-    256x128, and blurring each copy to its target's footprint lost the render noise that is
-    much of the truth's pixel detail (README, "Structure first")."""
+    about 60 % of the fine detail. Bilinear still averages some away; bilinear weights steepened
+    towards the nearest pixel kept it at 1024x512 but copied the near floor's sharper grain into
+    the blurred far floor at 256x128, and blurring each copy to its target's footprint lost the
+    render noise that is much of the truth's pixel detail (README, "Structure first")."""
     maps = panorama.maps
     r, c = (np.clip(np.rint(x).astype(np.int64), 0, n - 1) for x, n in zip(raster.coords(plane.points), raster.shape,
                                                                             strict=True))
@@ -165,8 +163,7 @@ def _copied(rho: np.ndarray, panorama: PanoramaReflectance, plane: HiddenPlane, 
     t = structure.shifts.shifts[label[sel]] * raster.cell
     source = plane.points[sel] + t[:, :1] * raster.v + t[:, 1:] * raster.u
     copy, weight = planeraster.sample_points(source, panorama.rho,
-                                             panorama.valid & (maps.surface_with == plane.surface), frame=maps.frame,
-                                             cubic=True)
+                                             panorama.valid & (maps.surface_with == plane.surface), frame=maps.frame)
     correction = planeraster.sample_raster(raster, structure.correction, plane.points[sel])
     ok = weight > 0.5
     out = rho.copy()

@@ -97,24 +97,6 @@ def test_panorama_lookup_ignores_invalid_pixels():
     assert np.allclose(values[ok, 0], 2.0) and values.max() < 2.0 + 1e-9
 
 
-def test_cubic_panorama_lookup_keeps_curvature_and_falls_back_beside_invalid_pixels():
-    from addon.geometry.latlong import uv_to_direction
-
-    rows, cols = np.mgrid[0:64, 0:128].astype(float)
-    image = np.stack([0.01 * (cols - 50.0) ** 2 + rows], axis=-1)  # Keys' cubic is exact on quadratics
-    valid = np.ones((64, 128), bool)
-    valid[:, 80] = False
-    x, y = np.array([40.3, 60.75, 79.4, 20.5]), np.array([30.2, 10.6, 20.5, 40.9])  # pixel coordinates
-    pts = uv_to_direction((x + 0.5) / 128, 1.0 - (y + 0.5) / 64)
-    exact = 0.01 * (x - 50.0) ** 2 + y
-    cubic, w_cubic = PR.sample_points(pts, image, valid, cubic=True)
-    plain, w_plain = PR.sample_points(pts, image, valid)
-    assert np.allclose(cubic[:2, 0], exact[:2], atol=1e-6)
-    assert np.abs(plain[:2, 0] - exact[:2]).max() > 1e-3  # bilinear cuts the parabola's chords
-    assert np.allclose(cubic[2], plain[2]) and np.allclose(w_cubic, w_plain)  # column 80 is within its reach
-    assert np.allclose(cubic[3, 0], exact[3], atol=1e-6)
-
-
 def test_raster_lookup_is_bilinear():
     r = PR.PlaneRaster(origin=np.zeros(3), u=np.array([1.0, 0, 0]), v=np.array([0, 1.0, 0]), cell=0.1, shape=(4, 5))
     rows, cols = np.mgrid[0:4, 0:5]
