@@ -156,22 +156,46 @@ def sample_panorama(raster: PlaneRaster, image: np.ndarray, valid: np.ndarray, *
 def sample_points(points: np.ndarray, image: np.ndarray, valid: np.ndarray, *, frame: Frame | None = None
                   ) -> tuple[np.ndarray, np.ndarray]:
     """`sample_panorama` at any points (..., 3) in the probe frame: (..., C) and (...)."""
-    frame = frame or Frame.whole(image.shape)
+    total, weight, _ = _bilinear(points, [image], valid, frame or Frame.whole(image.shape))
+    return total[0] / np.where(weight > 0.0, weight, 1.0)[..., None], weight
+
+
+def sample_points_keeping_grain(points: np.ndarray, image: np.ndarray, local_mean: np.ndarray, valid: np.ndarray, *,
+                                frame: Frame | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """`sample_points` whose deviations from the image's `local_mean` (the mean of the valid
+    pixels around each pixel) keep the spread of a single pixel. A bilinear lookup between pixels
+    averages up to four of them: their independent grain (sensor or render noise, the finest
+    texture) shrinks to as little as half its spread, and a copy of the photograph looks softer
+    than the photograph around it. Variance-preserving blending (Heitz and Neyret 2018) divides
+    the weighted deviations by the root of the summed squared weights, which gives i.i.d. grain
+    its own spread back while a smooth signal, equal to its local mean, is interpolated as before."""
+    (total, mean), weight, square = _bilinear(points, [image, local_mean], valid, frame or Frame.whole(image.shape))
+    norm = np.where(weight > 0.0, weight, 1.0)[..., None]
+    gain = (weight / np.sqrt(np.where(square > 0.0, square, 1.0)))[..., None]
+    return (mean + gain * (total - mean)) / norm, weight
+
+
+def _bilinear(points: np.ndarray, images: list[np.ndarray], valid: np.ndarray, frame: Frame
+              ) -> tuple[list[np.ndarray], np.ndarray, np.ndarray]:
+    """The bilinear weighted sums of each of `images` (h, w, C) at `points` (..., 3) over the
+    `valid` pixels, the sum of the weights and the sum of their squares."""
     u, v = latlong.direction_to_uv(points)
     x = u * frame.width - 0.5
     y = np.clip((1.0 - v) * frame.height - 0.5, 0.0, frame.height - 1.0)  # clamped at the poles
     x0, y0 = np.floor(x), np.floor(y)
     fx, fy = x - x0, y - y0
-    total = np.zeros((*u.shape, image.shape[2]))
-    weight = np.zeros(u.shape)
+    totals = [np.zeros((*u.shape, im.shape[2])) for im in images]
+    weight, square = np.zeros(u.shape), np.zeros(u.shape)
     for dy, wy in ((0, 1.0 - fy), (1, fy)):
         for dx, wx in ((0, 1.0 - fx), (1, fx)):
             rows = np.minimum(y0.astype(np.int64) + dy, frame.height - 1)
-            r, c, inside = frame.locate(rows, x0.astype(np.int64) + dx, image.shape)
+            r, c, inside = frame.locate(rows, x0.astype(np.int64) + dx, valid.shape)
             w = wy * wx * (inside & valid[r, c])
-            total += w[..., None] * image[r, c]
+            for total, im in zip(totals, images, strict=True):
+                total += w[..., None] * im[r, c]
             weight += w
-    return total / np.where(weight > 0.0, weight, 1.0)[..., None], weight
+            square += w * w
+    return totals, weight, square
 
 
 def sample_raster(raster: PlaneRaster, image: np.ndarray, points: np.ndarray) -> np.ndarray:

@@ -2,8 +2,10 @@
 import numpy as np
 import pytest
 
+from addon.geometry import latlong
 from addon.geometry import planeraster as PR
 from addon.geometry.raycast import trace_panorama
+from addon.segmentation.masks import box_mean
 from tests.engine.geometry.test_raycast import box
 
 FLOOR_Z = -1.0
@@ -104,6 +106,41 @@ def test_raster_lookup_is_bilinear():
     pts = np.array([[0.05 + 0.1 * 1.25, 0.05 + 0.1 * 2.5, 0.0], [0.0, 0.0, 0.0], [9.0, 9.0, 0.0]])
     got = PR.sample_raster(r, image, pts)[:, 0]
     assert np.allclose(got, [3 * 2.5 + 1.25, 0.0, 3 * 3 + 4])  # inside, clamped low, clamped high
+
+
+def _points_between_pixels(width: int, height: int, rng: np.random.Generator, n: int) -> np.ndarray:
+    """Directions at random sub-pixel positions, away from the poles and the seam."""
+    x = rng.uniform(8, width - 8, n)
+    y = rng.uniform(8, height - 8, n)
+    return latlong.uv_to_direction((x + 0.5) / width, 1.0 - (y + 0.5) / height)
+
+
+def test_lookup_keeping_grain_keeps_a_pixels_spread_where_bilinear_halves_it():
+    rng = np.random.default_rng(3)
+    image = 1.0 + 0.1 * rng.standard_normal((128, 256, 3))
+    valid = np.ones((128, 256), bool)
+    pts = _points_between_pixels(256, 128, rng, 20000)
+    plain, _ = PR.sample_points(pts, image, valid)
+    kept, weight = PR.sample_points_keeping_grain(pts, image, box_mean(image, valid, 1)[0], valid)
+    assert (weight > 0.999).all()
+    assert 0.55 < plain.std() / image.std() < 0.8  # bilinear averages the grain away
+    assert 0.88 < kept.std() / image.std() < 1.07
+    assert abs(kept.mean() - 1.0) < 0.005
+
+
+def test_lookup_keeping_grain_interpolates_a_smooth_image_as_bilinear_does():
+    rows, cols = np.mgrid[0:128, 0:256].astype(float)
+    image = np.stack([0.5 + 0.01 * rows + 0.003 * cols, 0.2 + 0.002 * cols, np.full_like(rows, 0.7)], axis=-1)
+    valid = np.ones((128, 256), bool)
+    valid[40:50] = False  # the mean around a pixel is taken over valid pixels only
+    pts = _points_between_pixels(256, 128, np.random.default_rng(4), 2000)
+    plain, w0 = PR.sample_points(pts, image, valid)
+    kept, w1 = PR.sample_points_keeping_grain(pts, image, box_mean(image, valid, 1)[0], valid)
+    row = (1.0 - latlong.direction_to_uv(pts)[1]) * 128 - 0.5
+    ok = (w0 > 0.999) & ((row < 37) | (row > 52))  # beside the band the valid mean is one-sided
+    assert np.array_equal(w0, w1) and ok.mean() > 0.7
+    # a plane is its own local mean, so the deviations scaled up are zero
+    assert np.abs(kept[ok] - plain[ok]).max() < 1e-9
 
 
 @pytest.mark.parametrize("degrees", [0.0, 20.0, 70.0, -35.0])
