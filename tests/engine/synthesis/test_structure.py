@@ -3,9 +3,10 @@ composes a hole from shifted copies, and the blend; against hand-made periodic a
 import numpy as np
 import pytest
 
+from addon.synthesis import structure
 from addon.synthesis.shift_map import candidate_shifts, lattice_shifts, shift_map
 from addon.synthesis.structure import fill_structured, structure_fill
-from addon.synthesis.texture import SynthesisParams
+from addon.synthesis.texture import SynthesisParams, membrane
 from addon.synthesis.translations import dominant_translations
 
 
@@ -191,3 +192,35 @@ def test_shift_map_leaves_what_no_shift_reaches():
     np.testing.assert_array_equal(got.image, img)
     got = shift_map(img, ~hole, hole, np.array([[0, 20], [0, -20]]))
     assert got.covered[hole].all()
+
+
+def test_membrane_with_little_conductance_across_planks_keeps_each_planks_step():
+    """Planks 12 rows wide along x, each with its own shade, the border values noisy: carried
+    along the planks, each keeps its own; the isotropic membrane mixes them in the middle."""
+    rng = np.random.default_rng(0)
+    shade = np.repeat(rng.random(8), 12)[:, None, None] * np.ones((96, 120, 1))
+    region = np.zeros((96, 120), bool)
+    region[6:90, 20:100] = True
+    noisy = shade + 0.02 * rng.standard_normal(shade.shape)
+    along = membrane(noisy, ~region, region, conductance=(0.01, 1.0))
+    both = membrane(noisy, ~region, region)
+    across = membrane(noisy.transpose(1, 0, 2), ~region.T, region.T, conductance=(1.0, 0.01)).transpose(1, 0, 2)
+    error = {name: float(np.abs(got - shade)[region].mean()) for name, got in
+             (("along", along), ("both", both), ("across", across))}
+    # 0.01 is not far below (pi / 80)^2: the planks' steps mix a little over 80 pixels
+    assert error["along"] < 0.75 * error["both"]
+    assert abs(error["across"] - error["along"]) < 1e-4  # the same, transposed
+
+
+@pytest.mark.parametrize("transpose", [False, True])
+def test_planks_blend_is_carried_along_the_planks(transpose, monkeypatch):
+    """The blend's conductance is small across the planks, whichever raster axis they follow."""
+    truth = _grain_planks(seed=1)
+    hole = _hole(160, 55, 105)
+    if transpose:
+        truth, hole = truth.transpose(1, 0, 2), hole.T
+    seen = []
+    monkeypatch.setattr(structure, "membrane", lambda *a, conductance: seen.append(conductance) or a[0] * 0)
+    assert structure_fill(np.where(hole[..., None], 0, truth), ~hole, hole) is not None
+    across = structure._ACROSS_PLANKS
+    assert seen == [(1.0, across) if transpose else (across, 1.0)]
