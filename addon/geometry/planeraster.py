@@ -156,46 +156,65 @@ def sample_panorama(raster: PlaneRaster, image: np.ndarray, valid: np.ndarray, *
 def sample_points(points: np.ndarray, image: np.ndarray, valid: np.ndarray, *, frame: Frame | None = None
                   ) -> tuple[np.ndarray, np.ndarray]:
     """`sample_panorama` at any points (..., 3) in the probe frame: (..., C) and (...)."""
-    total, weight, _ = _bilinear(points, [image], valid, frame or Frame.whole(image.shape))
-    return total[0] / np.where(weight > 0.0, weight, 1.0)[..., None], weight
+    frame = frame or Frame.whole(image.shape)
+    total, weight = 0.0, 0.0
+    for r, c, w in _bilinear_taps(points, valid, frame):
+        total = total + w[..., None] * image[r, c]
+        weight = weight + w
+    return total / np.where(weight > 0.0, weight, 1.0)[..., None], weight
 
 
-def sample_points_keeping_grain(points: np.ndarray, image: np.ndarray, local_mean: np.ndarray, valid: np.ndarray, *,
+def sample_points_keeping_grain(points: np.ndarray, image: np.ndarray, valid: np.ndarray, *,
                                 frame: Frame | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """`sample_points` whose deviations from the image's `local_mean` (the mean of the valid
-    pixels around each pixel) keep the spread of a single pixel. A bilinear lookup between pixels
-    averages up to four of them: their independent grain (sensor or render noise, the finest
-    texture) shrinks to as little as half its spread, and a copy of the photograph looks softer
-    than the photograph around it. Variance-preserving blending (Heitz and Neyret 2018) divides
-    the weighted deviations by the root of the summed squared weights, which gives i.i.d. grain
-    its own spread back while a smooth signal, equal to its local mean, is interpolated as before."""
-    (total, mean), weight, square = _bilinear(points, [image, local_mean], valid, frame or Frame.whole(image.shape))
+    """`sample_points` whose deviations from the local mean (of the valid pixels in the 3 x 3
+    around each pixel looked up) keep the spread of a single pixel. A bilinear lookup between
+    pixels averages up to four of them: their independent grain (sensor or render noise, the
+    finest texture) shrinks to as little as half its spread, and a copy of the photograph looks
+    softer than the photograph around it. Variance-preserving blending (Heitz and Neyret 2018)
+    divides the weighted deviations by the root of the summed squared weights, which gives
+    i.i.d. grain its own spread back while a smooth signal, equal to its local mean, is
+    interpolated as before."""
+    frame = frame or Frame.whole(image.shape)
+    total, mean, weight, square = 0.0, 0.0, 0.0, 0.0
+    for r, c, w in _bilinear_taps(points, valid, frame):
+        total = total + w[..., None] * image[r, c]
+        mean = mean + w[..., None] * _local_mean(image, valid, frame, r, c)
+        weight = weight + w
+        square = square + w * w
     norm = np.where(weight > 0.0, weight, 1.0)[..., None]
     gain = (weight / np.sqrt(np.where(square > 0.0, square, 1.0)))[..., None]
     return (mean + gain * (total - mean)) / norm, weight
 
 
-def _bilinear(points: np.ndarray, images: list[np.ndarray], valid: np.ndarray, frame: Frame
-              ) -> tuple[list[np.ndarray], np.ndarray, np.ndarray]:
-    """The bilinear weighted sums of each of `images` (h, w, C) at `points` (..., 3) over the
-    `valid` pixels, the sum of the weights and the sum of their squares."""
+def _bilinear_taps(points: np.ndarray, valid: np.ndarray, frame: Frame
+                   ) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """The four pixels (array row, array column) around each of `points` (..., 3) and their
+    bilinear weights, 0 where a pixel is not `valid` or not in the array."""
     u, v = latlong.direction_to_uv(points)
     x = u * frame.width - 0.5
     y = np.clip((1.0 - v) * frame.height - 0.5, 0.0, frame.height - 1.0)  # clamped at the poles
     x0, y0 = np.floor(x), np.floor(y)
     fx, fy = x - x0, y - y0
-    totals = [np.zeros((*u.shape, im.shape[2])) for im in images]
-    weight, square = np.zeros(u.shape), np.zeros(u.shape)
+    taps = []
     for dy, wy in ((0, 1.0 - fy), (1, fy)):
         for dx, wx in ((0, 1.0 - fx), (1, fx)):
             rows = np.minimum(y0.astype(np.int64) + dy, frame.height - 1)
             r, c, inside = frame.locate(rows, x0.astype(np.int64) + dx, valid.shape)
-            w = wy * wx * (inside & valid[r, c])
-            for total, im in zip(totals, images, strict=True):
-                total += w[..., None] * im[r, c]
-            weight += w
-            square += w * w
-    return totals, weight, square
+            taps.append((r, c, wy * wx * (inside & valid[r, c])))
+    return taps
+
+
+def _local_mean(image: np.ndarray, valid: np.ndarray, frame: Frame, r: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """The mean of the valid pixels in the 3 x 3 around array pixels (r, c) (the pixel's own
+    value where none is)."""
+    total, count = np.zeros((*r.shape, image.shape[2])), np.zeros(r.shape)
+    for dy in (-1, 0, 1):
+        for dx in (-1, 0, 1):
+            rr, cc, inside = frame.locate(r + frame.row0 + dy, c + frame.col0 + dx, valid.shape)
+            ok = inside & valid[rr, cc]
+            total += ok[..., None] * image[rr, cc]
+            count += ok
+    return np.where(count[..., None] > 0, total / np.maximum(count, 1)[..., None], image[r, c])
 
 
 def sample_raster(raster: PlaneRaster, image: np.ndarray, points: np.ndarray) -> np.ndarray:

@@ -15,7 +15,6 @@ import numpy as np
 
 from ..errors import DimredError
 from ..geometry import planeraster
-from ..segmentation.masks import box_mean
 from .structure import StructureFill, fill_structured
 from .texture import SynthesisParams
 
@@ -165,8 +164,7 @@ def _copied(rho: np.ndarray, panorama: PanoramaReflectance, plane: HiddenPlane, 
     t = structure.shifts.shifts[label[sel]] * raster.cell
     source = plane.points[sel] + t[:, :1] * raster.v + t[:, 1:] * raster.u
     valid = panorama.valid & (maps.surface_with == plane.surface)
-    copy, weight = planeraster.sample_points_keeping_grain(source, panorama.rho, box_mean(panorama.rho, valid, 1)[0],
-                                                           valid, frame=maps.frame)
+    copy, weight = planeraster.sample_points_keeping_grain(source, panorama.rho, valid, frame=maps.frame)
     correction = planeraster.sample_raster(raster, structure.correction, plane.points[sel])
     ok = weight > 0.5
     out = rho.copy()

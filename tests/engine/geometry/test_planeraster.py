@@ -5,7 +5,6 @@ import pytest
 from addon.geometry import latlong
 from addon.geometry import planeraster as PR
 from addon.geometry.raycast import trace_panorama
-from addon.segmentation.masks import box_mean
 from tests.engine.geometry.test_raycast import box
 
 FLOOR_Z = -1.0
@@ -121,7 +120,7 @@ def test_lookup_keeping_grain_keeps_a_pixels_spread_where_bilinear_halves_it():
     valid = np.ones((128, 256), bool)
     pts = _points_between_pixels(256, 128, rng, 20000)
     plain, _ = PR.sample_points(pts, image, valid)
-    kept, weight = PR.sample_points_keeping_grain(pts, image, box_mean(image, valid, 1)[0], valid)
+    kept, weight = PR.sample_points_keeping_grain(pts, image, valid)
     assert (weight > 0.999).all()
     assert 0.55 < plain.std() / image.std() < 0.8  # bilinear averages the grain away
     assert 0.88 < kept.std() / image.std() < 1.07
@@ -135,7 +134,7 @@ def test_lookup_keeping_grain_interpolates_a_smooth_image_as_bilinear_does():
     valid[40:50] = False  # the mean around a pixel is taken over valid pixels only
     pts = _points_between_pixels(256, 128, np.random.default_rng(4), 2000)
     plain, w0 = PR.sample_points(pts, image, valid)
-    kept, w1 = PR.sample_points_keeping_grain(pts, image, box_mean(image, valid, 1)[0], valid)
+    kept, w1 = PR.sample_points_keeping_grain(pts, image, valid)
     row = (1.0 - latlong.direction_to_uv(pts)[1]) * 128 - 0.5
     ok = (w0 > 0.999) & ((row < 37) | (row > 52))  # beside the band the valid mean is one-sided
     assert np.array_equal(w0, w1) and ok.mean() > 0.7
@@ -158,3 +157,19 @@ def test_edge_direction_follows_a_rotated_floor_not_its_diagonal(degrees):
     # The raster's columns run along one of the floor's sides.
     assert abs(u @ v) < 1e-12
     assert max(abs(u @ rot[:, 0]), abs(u @ rot[:, 1])) == pytest.approx(1.0, abs=1e-9)
+
+
+def test_lookup_keeping_grain_on_a_window_across_the_seam_equals_the_whole_panoramas():
+    rng = np.random.default_rng(5)
+    image = 1.0 + 0.1 * rng.standard_normal((64, 128, 3))
+    valid = rng.random((64, 128)) > 0.1
+    # a window of rows 20-43 and columns 100-127 then 0-19, wrapping around the seam
+    frame = PR.Frame(20, 100, 64, 128)
+    cols = np.r_[100:128, 0:20]
+    window, window_valid = image[20:44][:, cols], valid[20:44][:, cols]
+    u = (np.r_[rng.uniform(102, 127.5, 300), rng.uniform(0, 18, 300)] + 0.5) / 128
+    v = 1.0 - (rng.uniform(22, 41, 600) + 0.5) / 64
+    pts = latlong.uv_to_direction(u, v)
+    whole, w_whole = PR.sample_points_keeping_grain(pts, image, valid)
+    part, w_part = PR.sample_points_keeping_grain(pts, window, window_valid, frame=frame)
+    assert np.allclose(w_whole, w_part) and np.allclose(whole, part)
