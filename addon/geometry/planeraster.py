@@ -157,10 +157,14 @@ def sample_points(points: np.ndarray, image: np.ndarray, valid: np.ndarray, *, f
                   ) -> tuple[np.ndarray, np.ndarray]:
     """`sample_panorama` at any points (..., 3) in the probe frame: (..., C) and (...)."""
     frame = frame or Frame.whole(image.shape)
+    y0, x0, fy, fx = _lookup_position(points, frame)
     total, weight = 0.0, 0.0
-    for r, c, w in _bilinear_taps(points, valid, frame):
-        total = total + w[..., None] * image[r, c]
-        weight = weight + w
+    for dy, wy in ((0, 1.0 - fy), (1, fy)):
+        for dx, wx in ((0, 1.0 - fx), (1, fx)):
+            r, c, inside = frame.locate(np.minimum(y0 + dy, frame.height - 1), x0 + dx, valid.shape)
+            w = wy * wx * (inside & valid[r, c])
+            total = total + w[..., None] * image[r, c]
+            weight = weight + w
     return total / np.where(weight > 0.0, weight, 1.0)[..., None], weight
 
 
@@ -175,46 +179,41 @@ def sample_points_keeping_grain(points: np.ndarray, image: np.ndarray, valid: np
     i.i.d. grain its own spread back while a smooth signal, equal to its local mean, is
     interpolated as before."""
     frame = frame or Frame.whole(image.shape)
+    y0, x0, fy, fx = _lookup_position(points, frame)
+    # the 4 x 4 pixels around each point: its four taps and their 3 x 3 neighbourhoods
+    value, known = {}, {}
+    for oy in range(-1, 3):
+        for ox in range(-1, 3):
+            rows = y0 + oy
+            r, c, inside = frame.locate(rows, x0 + ox, valid.shape)
+            known[oy, ox] = inside & valid[r, c] & (rows >= 0) & (rows < frame.height)
+            value[oy, ox] = np.where(known[oy, ox][..., None], image[r, c], 0.0)
     total, mean, weight, square = 0.0, 0.0, 0.0, 0.0
-    for r, c, w in _bilinear_taps(points, valid, frame):
-        total = total + w[..., None] * image[r, c]
-        mean = mean + w[..., None] * _local_mean(image, valid, frame, r, c)
-        weight = weight + w
-        square = square + w * w
+    for dy, wy in ((0, 1.0 - fy), (1, fy)):
+        for dx, wx in ((0, 1.0 - fx), (1, fx)):
+            # (past the last row a tap is invalid here, where `sample_points` repeats the row:
+            # the point lies on the last row then, and that tap's weight is 0 either way)
+            near = [(dy + a, dx + b) for a in (-1, 0, 1) for b in (-1, 0, 1)]
+            count = sum(known[k].astype(np.float64) for k in near)
+            local = sum(value[k] for k in near) / np.maximum(count, 1)[..., None]
+            w = wy * wx * known[dy, dx]
+            total = total + w[..., None] * value[dy, dx]
+            mean = mean + w[..., None] * local
+            weight = weight + w
+            square = square + w * w
     norm = np.where(weight > 0.0, weight, 1.0)[..., None]
     gain = (weight / np.sqrt(np.where(square > 0.0, square, 1.0)))[..., None]
     return (mean + gain * (total - mean)) / norm, weight
 
 
-def _bilinear_taps(points: np.ndarray, valid: np.ndarray, frame: Frame
-                   ) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
-    """The four pixels (array row, array column) around each of `points` (..., 3) and their
-    bilinear weights, 0 where a pixel is not `valid` or not in the array."""
+def _lookup_position(points: np.ndarray, frame: Frame) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The panorama pixel (row, column) left of and above each point (..., 3), and the point's
+    fractional offset from it (rows, columns)."""
     u, v = latlong.direction_to_uv(points)
     x = u * frame.width - 0.5
     y = np.clip((1.0 - v) * frame.height - 0.5, 0.0, frame.height - 1.0)  # clamped at the poles
     x0, y0 = np.floor(x), np.floor(y)
-    fx, fy = x - x0, y - y0
-    taps = []
-    for dy, wy in ((0, 1.0 - fy), (1, fy)):
-        for dx, wx in ((0, 1.0 - fx), (1, fx)):
-            rows = np.minimum(y0.astype(np.int64) + dy, frame.height - 1)
-            r, c, inside = frame.locate(rows, x0.astype(np.int64) + dx, valid.shape)
-            taps.append((r, c, wy * wx * (inside & valid[r, c])))
-    return taps
-
-
-def _local_mean(image: np.ndarray, valid: np.ndarray, frame: Frame, r: np.ndarray, c: np.ndarray) -> np.ndarray:
-    """The mean of the valid pixels in the 3 x 3 around array pixels (r, c) (the pixel's own
-    value where none is)."""
-    total, count = np.zeros((*r.shape, image.shape[2])), np.zeros(r.shape)
-    for dy in (-1, 0, 1):
-        for dx in (-1, 0, 1):
-            rr, cc, inside = frame.locate(r + frame.row0 + dy, c + frame.col0 + dx, valid.shape)
-            ok = inside & valid[rr, cc]
-            total += ok[..., None] * image[rr, cc]
-            count += ok
-    return np.where(count[..., None] > 0, total / np.maximum(count, 1)[..., None], image[r, c])
+    return y0.astype(np.int64), x0.astype(np.int64), y - y0, x - x0
 
 
 def sample_raster(raster: PlaneRaster, image: np.ndarray, points: np.ndarray) -> np.ndarray:
