@@ -7,7 +7,7 @@ from addon.synthesis import structure
 from addon.synthesis.shift_map import candidate_shifts, lattice_shifts, shift_map
 from addon.synthesis.structure import fill_structured, structure_fill
 from addon.synthesis.texture import SynthesisParams, membrane
-from addon.synthesis.translations import dominant_translations
+from addon.synthesis.translations import DOMINANT, dominant_translations
 
 
 def _tiles(size=160, period=20, grout=2, seed=0):
@@ -224,3 +224,30 @@ def test_planks_blend_is_carried_along_the_planks(transpose, monkeypatch):
     assert structure_fill(np.where(hole[..., None], 0, truth), ~hole, hole) is not None
     across = structure._ACROSS_PLANKS
     assert seen == [(1.0, across) if transpose else (across, 1.0)]
+
+
+def _striped_planks(size=160, seed=0, width=24):
+    """Planks of random lengths and tones whose grain repeats every 7 rows across them (the
+    benchmark's planks): a tiling whose list of translations holds shifts too long to check
+    around a small hole, which are no repeats."""
+    rng = np.random.default_rng(seed)
+    y, x = np.mgrid[:size, :size]
+    row = y // width
+    length, start = rng.integers(50, 100, size // width + 1), rng.integers(0, 100, size // width + 1)
+    tone = 1 + 0.10 * rng.standard_normal((size // width + 1, size))
+    shade = tone[row, (x + start[row]) // length[row]] * (0.85 + 0.075 * (1 + np.sin(2 * np.pi * y / 7.0)))
+    img = np.array([0.55, 0.36, 0.20]) * shade[..., None] + 0.01 * rng.standard_normal((size, size, 1))
+    img[((y % width) < 2) | (((x + start[row]) % length[row]) < 2)] *= 0.4
+    return img.astype(np.float32)
+
+
+def test_a_tilings_labels_combine_its_repeats_only():
+    truth = _striped_planks()
+    hole = _hole(160, 64, 96)
+    got = structure_fill(np.where(hole[..., None], 0, truth), ~hole, hole)
+    t = got.translations
+    assert t.tiling and (t.contrast[:8] > DOMINANT).any()  # the list holds shifts that are no repeat
+    base = t.shifts[t.contrast <= DOMINANT][:8]
+    base = np.concatenate([base, -base])
+    combined = {tuple(x) for x in np.concatenate([base, 2 * base, (base[:, None] + base[None]).reshape(-1, 2)])}
+    assert {tuple(x) for x in got.shifts.shifts} <= combined
