@@ -159,12 +159,11 @@ def sample_points(points: np.ndarray, image: np.ndarray, valid: np.ndarray, *, f
     frame = frame or Frame.whole(image.shape)
     y0, x0, fy, fx = _lookup_position(points, frame)
     total, weight = 0.0, 0.0
-    for dy, wy in ((0, 1.0 - fy), (1, fy)):
-        for dx, wx in ((0, 1.0 - fx), (1, fx)):
-            r, c, inside = frame.locate(np.minimum(y0 + dy, frame.height - 1), x0 + dx, valid.shape)
-            w = wy * wx * (inside & valid[r, c])
-            total = total + w[..., None] * image[r, c]
-            weight = weight + w
+    for dy, dx, w in _bilinear_weights(fy, fx):
+        r, c, inside = frame.locate(np.minimum(y0 + dy, frame.height - 1), x0 + dx, valid.shape)
+        w = w * (inside & valid[r, c])
+        total = total + w[..., None] * image[r, c]
+        weight = weight + w
     return total / np.where(weight > 0.0, weight, 1.0)[..., None], weight
 
 
@@ -184,26 +183,29 @@ def sample_points_keeping_grain(points: np.ndarray, image: np.ndarray, valid: np
     value, known = {}, {}
     for oy in range(-1, 3):
         for ox in range(-1, 3):
-            rows = y0 + oy
-            r, c, inside = frame.locate(rows, x0 + ox, valid.shape)
-            known[oy, ox] = inside & valid[r, c] & (rows >= 0) & (rows < frame.height)
+            r, c, inside = frame.locate(y0 + oy, x0 + ox, valid.shape)  # rows past the poles are outside
+            known[oy, ox] = inside & valid[r, c]
             value[oy, ox] = np.where(known[oy, ox][..., None], image[r, c], 0.0)
     total, mean, weight, square = 0.0, 0.0, 0.0, 0.0
-    for dy, wy in ((0, 1.0 - fy), (1, fy)):
-        for dx, wx in ((0, 1.0 - fx), (1, fx)):
-            # (past the last row a tap is invalid here, where `sample_points` repeats the row:
-            # the point lies on the last row then, and that tap's weight is 0 either way)
-            near = [(dy + a, dx + b) for a in (-1, 0, 1) for b in (-1, 0, 1)]
-            count = sum(known[k].astype(np.float64) for k in near)
-            local = sum(value[k] for k in near) / np.maximum(count, 1)[..., None]
-            w = wy * wx * known[dy, dx]
-            total = total + w[..., None] * value[dy, dx]
-            mean = mean + w[..., None] * local
-            weight = weight + w
-            square = square + w * w
+    for dy, dx, w in _bilinear_weights(fy, fx):
+        # (past the last row a tap is invalid here, where `sample_points` repeats the row: the
+        # point lies on the last row then, and that tap's weight is 0 either way)
+        near = [(dy + a, dx + b) for a in (-1, 0, 1) for b in (-1, 0, 1)]
+        count = sum(known[k].astype(np.float64) for k in near)
+        local = sum(value[k] for k in near) / np.maximum(count, 1)[..., None]
+        w = w * known[dy, dx]
+        total = total + w[..., None] * value[dy, dx]
+        mean = mean + w[..., None] * local
+        weight = weight + w
+        square = square + w * w
     norm = np.where(weight > 0.0, weight, 1.0)[..., None]
     gain = (weight / np.sqrt(np.where(square > 0.0, square, 1.0)))[..., None]
     return (mean + gain * (total - mean)) / norm, weight
+
+
+def _bilinear_weights(fy: np.ndarray, fx: np.ndarray) -> list[tuple[int, int, np.ndarray]]:
+    """(row step, column step, weight) of the four taps at fractional offsets (fy, fx)."""
+    return [(dy, dx, wy * wx) for dy, wy in ((0, 1.0 - fy), (1, fy)) for dx, wx in ((0, 1.0 - fx), (1, fx))]
 
 
 def _lookup_position(points: np.ndarray, frame: Frame) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
