@@ -10,50 +10,32 @@ Renders are cached (scenes.render); the first run renders what is missing (minut
 """
 from __future__ import annotations
 
-import argparse
-import sys
-from pathlib import Path
-
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from rendered import ground_truths, scene_list_arguments
 
-SCENES = "basic_box,wall_contact,far_dark_box,stool,warm_cylinder,demo"
+SCENES = "basic_box,wall_contact,far_dark_box,tile_stool,stool,warm_cylinder,demo,oak_chair,walnut_crate,far_pouf"
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--scenes", default=SCENES)
-    ap.add_argument("--width", type=int, default=1024)
-    ap.add_argument("--samples", type=int, default=16, help="Cycles samples (the demo always gets 32)")
-    args = ap.parse_args()
+    args = scene_list_arguments(__doc__, SCENES)
 
-    import bpy
-
-    from addon.blender import reader
     from addon.pipeline import remove_object
-    from scenes import metrics, spec
-    from scenes.images import read_exr
-    from scenes.render import render_pair
+    from scenes import metrics
 
     print(f"{args.width}x{args.width // 2}, balanced, exact proxies")
     print()
     print("| scene | floor | structure-aware | structure | detail | mean | object + shadow | NaN | fill s "
           "| synthesis s | hidden light s |")
     print("|---|---|---|---|---|---|---|---|---|---|---|")
-    for name in args.scenes.split(","):
-        s = spec.get(name)
-        s = s.with_render(width=args.width, height=args.width // 2, samples=32 if name == "demo" else args.samples)
-        paths = render_pair(s)
-        bpy.ops.wm.open_mainfile(filepath=str(paths["blend"]))
-        scene = reader.read_scene(bpy.context.scene)
-        inp, truth, mask = read_exr(paths["input"]), read_exr(paths["truth"]), np.load(paths["mask"])
+    for gt in ground_truths(args):
+        s = gt.spec
         for structure in (True, False):
-            r = remove_object(scene, s.remove, quality="balanced", synth_structure=structure)
-            edit = inp + r.difference
-            h = metrics.hidden_region_scores(inp, edit, truth, mask)
+            r = remove_object(gt.scene, s.remove, quality="balanced", synth_structure=structure)
+            edit = gt.input + r.difference
+            h = metrics.hidden_region_scores(gt.input, edit, gt.truth, gt.mask)
             fill_s = sum(f["seconds"] for f in r.report["filled_surfaces"])
-            print(f"| {name} | {s.room.floor.pattern} | {'on' if structure else 'off'} | {h['structure']:.3f} "
+            print(f"| {s.name} | {s.room.floor.pattern} | {'on' if structure else 'off'} | {h['structure']:.3f} "
                   f"| {h['detail_ratio']:.2f} | {h['mean_ratio']:.3f} | {h['object_shadow_ratio']:.3f} "
                   f"| {int(np.isnan(edit).sum())} | {fill_s:.2f} | {r.report['seconds']['synthesis']:.2f} "
                   f"| {r.report['seconds']['hidden_light']:.2f} |", flush=True)

@@ -3,7 +3,12 @@ from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Iterator
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
+
+import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
@@ -28,3 +33,41 @@ def open_scene(args: argparse.Namespace) -> tuple[scene_specs.SceneSpec, dict[st
 
     open_blend(str(paths["blend"]))
     return spec, paths
+
+
+def scene_list_arguments(description: str, scenes: str) -> argparse.Namespace:
+    """Parsed --scenes (comma-separated, default `scenes`), --width (height = width / 2) and
+    --samples (the demo always gets 32)."""
+    ap = argparse.ArgumentParser(description=description, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--scenes", default=scenes)
+    ap.add_argument("--width", type=int, default=1024)
+    ap.add_argument("--samples", type=int, default=16, help="Cycles samples (the demo always gets 32)")
+    return ap.parse_args()
+
+
+@dataclass(frozen=True)
+class GroundTruth:
+    """A rendered pair: its spec, the panorama with the object and without it, the object's
+    mask, and the scene as the add-on reads it from the opened .blend."""
+
+    spec: scene_specs.SceneSpec
+    input: np.ndarray
+    truth: np.ndarray
+    mask: np.ndarray
+    scene: Any
+
+
+def ground_truths(args: argparse.Namespace) -> Iterator[GroundTruth]:
+    """Each of `args.scenes` rendered unless cached and opened in Blender, in turn."""
+    import bpy
+
+    from addon.blender import reader
+    from scenes.images import read_exr
+
+    for name in args.scenes.split(","):
+        spec = scene_specs.get(name).with_render(width=args.width, height=args.width // 2,
+                                                 samples=32 if name == "demo" else args.samples)
+        paths = render_pair(spec)
+        bpy.ops.wm.open_mainfile(filepath=str(paths["blend"]))
+        yield GroundTruth(spec, read_exr(paths["input"]), read_exr(paths["truth"]), np.load(paths["mask"]),
+                          reader.read_scene(bpy.context.scene))

@@ -499,6 +499,66 @@ def _warm_cylinder() -> SceneSpec:
     )
 
 
+def _oak_chair() -> SceneSpec:
+    room = Room(lo=(-2.2, -2.4, 0.0), hi=(2.8, 2.0, 2.6), wall_albedo=(0.8, 0.78, 0.74),
+                floor=Floor("planks", (0.55, 0.4, 0.26), (0.7, 0.56, 0.4), 0.12))
+    # Narrow light planks whose joints repeat clearly enough to read as a tiling; a square
+    # four-legged seat whose shadow the floor between its legs shows.
+    return SceneSpec(
+        name="oak_chair",
+        room=room,
+        lamps=(Lamp((0.8, 1.0), (0.6, 0.6), 30.0, (1.0, 0.92, 0.8)), Lamp((-1.2, -1.4), (0.4, 0.8), 16.0)),
+        objects=(SceneObject("Chair", "stool", (0.45, 0.45, 0.5), _on_floor(room, 1.1, 1.0), (0.3, 0.2, 0.15),
+                             rotation_z=-15.0, seat="square", legs=4, leg_width=0.04),),
+        probe=(0.1, 0.0, 1.5),
+        remove="Chair",
+    )
+
+
+def _walnut_crate() -> SceneSpec:
+    room = Room(lo=(-2.8, -2.0, 0.0), hi=(2.4, 2.6, 2.7), wall_albedo=(0.7, 0.72, 0.75),
+                floor=Floor("planks", (0.3, 0.18, 0.1), (0.45, 0.3, 0.18), 0.22))
+    # Wide dark planks, a light crate turned 40 degrees, a cool lamp and a warm one.
+    return SceneSpec(
+        name="walnut_crate",
+        room=room,
+        lamps=(Lamp((-1.0, 0.5), (0.5, 0.5), 38.0), Lamp((1.5, -1.0), (0.3, 0.9), 12.0, (0.9, 0.95, 1.0))),
+        objects=(SceneObject("Crate", "box", (0.6, 0.4, 0.45), _on_floor(room, -1.3, -0.8), (0.55, 0.5, 0.4),
+                             rotation_z=40.0),),
+        probe=(0.0, 0.2, 1.55),
+        remove="Crate",
+    )
+
+
+def _far_pouf() -> SceneSpec:
+    room = Room(lo=(-2.0, -2.2, 0.0), hi=(3.6, 2.2, 2.8), wall_albedo=(0.76, 0.74, 0.7),
+                floor=Floor("planks", (0.48, 0.3, 0.17), (0.58, 0.42, 0.26), 0.16))
+    # 2.5 m from the probe under a single warm lamp: planks of close shades the panorama
+    # resolves coarsely there.
+    return SceneSpec(
+        name="far_pouf",
+        room=room,
+        lamps=(Lamp((2.0, 0.0), (0.8, 0.5), 32.0, (1.0, 0.85, 0.7)),),
+        objects=(SceneObject("Pouf", "cylinder", (0.5, 0.5, 0.4), _on_floor(room, 2.3, -0.9), (0.6, 0.2, 0.2)),),
+        probe=(0.0, 0.0, 1.5),
+        remove="Pouf",
+    )
+
+
+def _tile_stool() -> SceneSpec:
+    room = Room(lo=(-2.4, -2.0, 0.0), hi=(2.4, 2.4, 2.6), wall_albedo=(0.74, 0.74, 0.74),
+                floor=Floor("checker", (0.7, 0.68, 0.64), (0.32, 0.3, 0.3), 0.25))
+    return SceneSpec(
+        name="tile_stool",
+        room=room,
+        lamps=(Lamp((0.2, 1.2), (0.5, 0.5), 30.0), Lamp((-1.5, -1.0), (0.5, 0.5), 15.0)),
+        objects=(SceneObject("Stool", "stool", (0.4, 0.4, 0.6), _on_floor(room, -1.0, 1.1), (0.4, 0.25, 0.15),
+                             rotation_z=20.0, seat="round", legs=3),),
+        probe=(0.0, 0.0, 1.5),
+        remove="Stool",
+    )
+
+
 SPECS: dict[str, SceneSpec] = {s.name: s for s in (
     _basic_box(),
     _red_box(),
@@ -519,6 +579,10 @@ SPECS: dict[str, SceneSpec] = {s.name: s for s in (
     _far_dark_box(),
     _tall_cabinet(),
     _warm_cylinder(),
+    _oak_chair(),
+    _walnut_crate(),
+    _far_pouf(),
+    _tile_stool(),
 )}
 
 

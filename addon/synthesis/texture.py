@@ -670,15 +670,12 @@ def _refine_offsets(offsets: np.ndarray, image: np.ndarray, ring: np.ndarray, ex
     return offsets + steps[step], score[np.arange(len(offsets)), step]
 
 
-def membrane(values: np.ndarray, fixed: np.ndarray, region: np.ndarray, *,
-             conductance: tuple[float, float] = (1.0, 1.0)) -> np.ndarray:
+def membrane(values: np.ndarray, fixed: np.ndarray, region: np.ndarray) -> np.ndarray:
     """`values` (H, W, C) interpolated over `region` from the pixels `fixed` around it: the
     membrane (discrete Laplace equation over 4-neighbours) that takes the fixed values at the
     region's border; neighbours neither fixed nor in the region carry no flux. Unlike a pull-push
     average it follows the border value by value, so the fill meets each known pixel. Relaxed
-    from the pull-push estimate by _MEMBRANE_STEPS conjugate-gradient steps; 0 outside the region.
-    `conductance` weighs the flux between rows and between columns: a small one across an axis
-    carries the border values further along the other."""
+    from the pull-push estimate by _MEMBRANE_STEPS conjugate-gradient steps; 0 outside the region."""
     out = np.zeros(values.shape, np.float32)
     if not region.any():
         return out
@@ -687,17 +684,14 @@ def membrane(values: np.ndarray, fixed: np.ndarray, region: np.ndarray, *,
     known = fixed[y0:y1, x0:x1] & ~inside
     mask = inside[..., None].astype(np.float32)
     # neighbours that count: unknowns (coupled) and fixed pixels (their values go into b)
-    k = [np.float32(conductance[0] if dy else conductance[1]) for dy, _ in _STEPS4]
-    degree = sum(c * (_neighbour(inside, d) | _neighbour(known, d)).astype(np.float32)
-                 for c, d in zip(k, _STEPS4, strict=True))[..., None] * mask
+    degree = sum((_neighbour(inside, d) | _neighbour(known, d)).astype(np.float32) for d in _STEPS4)[..., None] * mask
     v = np.where(known[..., None], values[y0:y1, x0:x1], 0).astype(np.float32)
-    b = sum(c * _neighbour(v, d) for c, d in zip(k, _STEPS4, strict=True)) * mask
+    b = sum(_neighbour(v, d) for d in _STEPS4) * mask
 
     def laplacian(x: np.ndarray) -> np.ndarray:  # on the unknowns; x is 0 elsewhere, so its neighbours there add 0
         xp = np.pad(x, ((1, 1), (1, 1), (0, 0)))
         h, w = x.shape[:2]
-        return (degree * x - sum(c * xp[1 + dy:1 + dy + h, 1 + dx:1 + dx + w]
-                                 for c, (dy, dx) in zip(k, _STEPS4, strict=True))) * mask
+        return (degree * x - sum(xp[1 + dy:1 + dy + h, 1 + dx:1 + dx + w] for dy, dx in _STEPS4)) * mask
 
     x = np.where(inside[..., None], _pull_push(values, fixed.astype(np.float32))[y0:y1, x0:x1], 0).astype(np.float32)
     r = b - laplacian(x)

@@ -87,11 +87,13 @@ def dominant_translations(image: np.ndarray, known: np.ndarray, hole: np.ndarray
     return Translations(shifts[order], diff[order] / max(_typical_difference(luma, known, hole), 1e-30))
 
 
-def relative_difference(image: np.ndarray, known: np.ndarray, hole: np.ndarray, shifts: np.ndarray) -> np.ndarray:
-    """(K,) how well the known pixels around the `hole` match themselves under each shift,
-    relative to an arbitrary shift (as `Translations.contrast`; inf where too few pairs)."""
+def relative_difference(image: np.ndarray, known: np.ndarray, hole: np.ndarray, shifts: np.ndarray, *,
+                        ring: int = 8) -> np.ndarray:
+    """(K,) how well the known pixels within `ring` of the `hole`'s bounding box match themselves
+    under each shift, relative to an arbitrary shift (as `Translations.contrast`; inf where too
+    few pairs)."""
     luma = image.mean(axis=2)
-    ys, xs = _ring(hole, known, 8)
+    ys, xs = _ring(hole, known, ring)
     diff = _pair_difference(luma, known, ys, xs, np.asarray(shifts, np.int64).reshape(-1, 2))
     return diff / max(_typical_difference(luma, known, hole), 1e-30)
 

@@ -1,0 +1,114 @@
+"""What a fill made from the visible floor can reach in structure on plank floors, measured on
+the truth itself (the render without the object: no lighting estimate, no reflectance, only
+what the probe sees of the floor):
+    .venv/bin/python benchmarks/bench_fill_ceiling.py [--scenes a,b] [--width 1024]
+For each of the object's pixels whose ray meets the floor, the floor is followed along the
+planks (the scenes' planks run along x), both ways in 5 mm steps, to the nearest point the probe
+sees (its pixel is not the object's). Two fills of the truth's own pixels, scored as
+`bench_fill_groundtruth` scores ours (`scenes.metrics.structure_correlation`) over those floor
+pixels:
+- copy: the truth at the nearer of the two points (a shift map's best copy, per pixel);
+- interpolation: linear between the two, each the mean over 3 cm beyond it (as `lines`).
+The last column is our removal's fill over the same pixels (balanced, exact proxies).
+Renders are cached (scenes.render); the first run renders what is missing (minutes each).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from rendered import ground_truths, scene_list_arguments
+from scenes.spec import SceneSpec
+
+SCENES = "demo,stool,warm_cylinder,oak_chair,walnut_crate,far_pouf"
+STEP = 0.005  # metres along the planks
+REACH = 2.0  # metres searched each way
+ENDS = 0.03  # metres averaged beyond each visible end
+
+
+def _floor_points(spec: SceneSpec, width: int, height: int, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The object's pixels whose ray meets the floor inside the room, and those points
+    relative to the probe."""
+    from addon.geometry import latlong
+
+    d = latlong.pixel_directions(width, height)
+    down = d[..., 2] < -1e-3
+    t = np.where(down, -spec.probe[2] / np.where(down, d[..., 2], -1.0), 0.0)
+    p = d * t[..., None]
+    world = p + np.asarray(spec.probe)
+    lo, hi = np.asarray(spec.room.lo) + 0.01, np.asarray(spec.room.hi) - 0.01
+    inside = (world[..., 0] > lo[0]) & (world[..., 0] < hi[0]) & (world[..., 1] > lo[1]) & (world[..., 1] < hi[1])
+    floor = mask & down & inside
+    return floor, p[floor]
+
+
+def _nearest_seen(points: np.ndarray, sign: int, mask: np.ndarray, spec: SceneSpec) -> tuple[np.ndarray, np.ndarray]:
+    """(N,) the distance along x to the nearest point the probe sees (inf where none within
+    REACH), and (N, 3) that point."""
+    from addon.geometry import latlong
+
+    h, w = mask.shape
+    steps = sign * STEP * np.arange(1, int(REACH / STEP) + 1)
+    moved = points[None] + steps[:, None, None] * np.array([1.0, 0.0, 0.0])
+    u, v = latlong.direction_to_uv(moved)
+    col = np.clip((u * w).astype(np.int64), 0, w - 1)
+    row = np.clip(((1.0 - v) * h).astype(np.int64), 0, h - 1)
+    x = moved[..., 0] + spec.probe[0]
+    seen = ~mask[row, col] & (x > spec.room.lo[0]) & (x < spec.room.hi[0])
+    first = seen.argmax(axis=0)
+    found = seen[first, np.arange(len(points))]
+    distance = np.where(found, np.abs(steps[first]), np.inf)
+    return distance, moved[first, np.arange(len(points))]
+
+
+def _end_mean(points: np.ndarray, sign: int, truth: np.ndarray) -> np.ndarray:
+    from addon.geometry import planeraster
+
+    valid = np.ones(truth.shape[:2], bool)
+    offsets = sign * np.arange(0.0, ENDS + 1e-9, STEP)
+    return np.mean([planeraster.sample_points(points + o * np.array([1.0, 0.0, 0.0]), truth, valid)[0]
+                    for o in offsets], axis=0)
+
+
+def _scored(values: np.ndarray, truth: np.ndarray, floor: np.ndarray, reached: np.ndarray) -> float:
+    """Structure of the truth with its `floor` pixels replaced by `values` where `reached`."""
+    from scenes import metrics
+
+    edit = truth.copy()
+    edit[floor] = np.where(reached[:, None], values, truth[floor])
+    return metrics.structure_correlation(edit, truth, floor)
+
+
+def main() -> None:
+    args = scene_list_arguments(__doc__, SCENES)
+
+    from addon.geometry import planeraster
+    from addon.pipeline import remove_object
+    from scenes import metrics
+
+    print(f"{args.width}x{args.width // 2}, structure over the object's floor pixels")
+    print()
+    print("| scene | floor pixels | median distance to seen floor m | copy | interpolation | ours |")
+    print("|---|---|---|---|---|---|")
+    for gt in ground_truths(args):
+        s, truth, mask = gt.spec, gt.truth, gt.mask
+        if s.room.floor.pattern != "planks" or s.world_rotation_z:
+            raise SystemExit(f"{s.name}: planks along x in an unrotated world only")
+        floor, points = _floor_points(s, mask.shape[1], mask.shape[0], mask)
+        (after, at_after), (before, at_before) = (_nearest_seen(points, sign, mask, s) for sign in (1, -1))
+        valid = np.ones(mask.shape, bool)
+        nearer = np.where((after <= before)[:, None], at_after, at_before)
+        copy = planeraster.sample_points(nearer, truth, valid)[0]
+        both = np.isfinite(after) & np.isfinite(before)
+        share = np.where(both, before / np.where(both, after + before, 1.0), np.isfinite(after).astype(float))
+        interpolated = (share[:, None] * _end_mean(at_after, 1, truth)
+                        + (1 - share[:, None]) * _end_mean(at_before, -1, truth))
+        reached = np.isfinite(np.minimum(after, before))
+        r = remove_object(gt.scene, s.remove, quality="balanced")
+        ours = metrics.structure_correlation(gt.input + r.difference, truth, floor)
+        print(f"| {s.name} | {int(floor.sum())} | {np.median(np.minimum(after, before)[reached]):.2f} "
+              f"| {_scored(copy, truth, floor, reached):.3f} | {_scored(interpolated, truth, floor, reached):.3f} "
+              f"| {ours:.3f} |", flush=True)
+
+
+if __name__ == "__main__":
+    main()
