@@ -73,7 +73,8 @@ def fill_hidden(solution: Solution, revealed: Revealed, light: HiddenLight, rep:
     irradiance after removal (`light`).
 
     `show(change)` gets the revealed pixels' change as the fill refines: first with each
-    patch's mean reflectance, then after every synthesis level of every surface."""
+    patch's mean reflectance, then after every synthesis level of every surface and with each
+    surface's final fill."""
     geo = solution.geo
     rho = light.rho.copy()
 
@@ -103,6 +104,8 @@ def fill_hidden(solution: Solution, revealed: Revealed, light: HiddenLight, rep:
         name = geo.object_names[geo.tri_object[revealed.tri[sel[0]]]]
         if got.known_cells:
             rho[sel] = got.rho
+            if show is not None:  # with the photograph's fine detail, which the levels do not show
+                show(change())
         if not got.synthesised:
             rep.warn(f"too little of '{name}' is seen around the object to synthesise its texture: "
                      f"{len(sel)} pixels get its mean reflectance")

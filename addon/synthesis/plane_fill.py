@@ -15,7 +15,7 @@ import numpy as np
 
 from ..errors import DimredError
 from ..geometry import planeraster
-from .structure import StructureFill, fill_structured
+from .structure import Filled, fill_structured
 from .texture import SynthesisParams
 
 _MAX_CELLS = 512 * 512  # bounds the raster (and the exemplar) whatever the panorama size
@@ -114,23 +114,24 @@ def fill_surface(
     hole &= ~known
     mean = values[known].mean(axis=0) if known.any() else np.zeros(3)
     image = np.where(known[..., None], values, mean)
-    synthesised, structure = False, None
+    filled = None
     if known.sum() >= _MIN_KNOWN:
         on_level = None if progress is None else (
             lambda _level, preview: progress(planeraster.sample_raster(raster, preview, points)))
         try:
             footprint = _footprint(raster) if options.structure else None
-            image, structure = fill_structured(image, known, hole, options.synthesis, structure=options.structure,
-                                               footprint=footprint, seed=options.seed, progress=on_level,
-                                               cancel=cancel)
-            synthesised = True
+            filled = fill_structured(image, known, hole, options.synthesis, structure=options.structure,
+                                     footprint=footprint, seed=options.seed, progress=on_level, cancel=cancel)
         except DimredError:
             pass  # too little exemplar: the mean below is the honest fallback, reported by the caller
-    rho = planeraster.sample_raster(raster, image, points)
-    if structure is not None:
-        rho = _copied(rho, panorama, plane, raster, structure)
+    if filled is None:
+        rho = planeraster.sample_raster(raster, image, points)
+    else:
+        rho = _with_photograph_detail(planeraster.sample_raster(raster, filled.image, points), panorama, plane,
+                                      raster, _copy_field(filled, image))
+    structure = None if filled is None else filled.structure
     return SurfaceFill(rho=rho, raster_shape=raster.shape, cell=raster.cell, known_cells=int(known.sum()),
-                       hole_cells=int(hole.sum()), synthesised=synthesised,
+                       hole_cells=int(hole.sum()), synthesised=filled is not None,
                        structured=0 if structure is None else int(structure.covered.sum()))
 
 
@@ -144,30 +145,57 @@ def _footprint(raster: planeraster.PlaneRaster) -> np.ndarray:
     return dist * np.sqrt(np.maximum(cos_lat, 1e-3) / np.maximum(cos_incidence, 1e-3))
 
 
-def _copied(rho: np.ndarray, panorama: PanoramaReflectance, plane: HiddenPlane, raster: planeraster.PlaneRaster,
-            structure: StructureFill) -> np.ndarray:
-    """`rho` at the hidden points whose cell the shift map composed, plus the detail of the
-    photograph finer than the raster: the copy read from the panorama itself, at the point moved
-    by the cell's shift, minus the same copy at the raster's resolution (weighed by
-    `structure.detail`). A copy through the raster alone (panorama to raster to panorama) kept
-    about 60 % of the fine detail. The lookup keeps a single pixel's grain
-    (`planeraster.sample_points_keeping_grain`): a plain bilinear lookup kept 0.64-0.81 of the
-    truth's pixel detail at 1024x512, this one 0.87-1.03, for 0.00-0.02 of structure (the
-    copy's grain is its own, not the truth's). Sharper lookups that move or blur the copy did
-    worse (README, "Structure first")."""
+@dataclass(frozen=True)
+class _CopyField:
+    """Per raster cell filled by a copy: `shift` (H, W, 2) from the cell to its source, in cells;
+    `copied` (H, W) where there is one; `detail` (H, W) the weight of the photograph's finer
+    detail there; `exemplar` (H, W, C) the raster the copies were taken from."""
+
+    shift: np.ndarray
+    copied: np.ndarray
+    detail: np.ndarray
+    exemplar: np.ndarray
+
+
+def _copy_field(filled: Filled, exemplar: np.ndarray) -> _CopyField:
+    """Where the fill copied each cell from: the shift map's shifts where composed, the
+    synthesis's sources (pixels of `exemplar`, the raster before the fill) elsewhere."""
+    sources, structure = filled.sources, filled.structure
+    copied = sources[..., 0] >= 0
+    shift = np.where(copied[..., None], sources - np.indices(copied.shape).transpose(1, 2, 0), 0)
+    detail = np.ones(copied.shape)
+    if structure is not None:
+        covered = structure.covered
+        shift[covered] = structure.shifts.shifts[structure.shifts.labels[covered]]
+        detail[covered] = structure.detail
+        copied = copied | covered
+    return _CopyField(shift, copied, detail, exemplar)
+
+
+def _with_photograph_detail(rho: np.ndarray, panorama: PanoramaReflectance, plane: HiddenPlane,
+                            raster: planeraster.PlaneRaster, field: _CopyField) -> np.ndarray:
+    """`rho` at the hidden points whose cell the fill copied from elsewhere (composed or
+    synthesised), plus the detail of the photograph finer than the raster: the copy read from
+    the panorama itself, at the point moved by the cell's shift, minus the same copy at the
+    raster's resolution (weighed by `field.detail`). A copy through the raster alone (panorama to
+    raster to panorama) kept about 60 % of the fine detail: at 1024x512 the per-pixel synthesis
+    of a plain wall or floor came out at 0.42-0.58 of the truth's detail, 0.74-0.88 with it. The
+    lookup keeps a single pixel's grain (`planeraster.sample_points_keeping_grain`): a plain
+    bilinear lookup kept 0.64-0.81 of the truth's pixel detail at 1024x512 on composed floors,
+    this one 0.87-1.03, for 0.00-0.02 of structure (the copy's grain is its own, not the
+    truth's). Sharper lookups that move or blur the copy did worse (README, "Structure first")."""
     maps = panorama.maps
     r, c = (np.clip(np.rint(x).astype(np.int64), 0, n - 1) for x, n in zip(raster.coords(plane.points), raster.shape,
                                                                             strict=True))
-    label = structure.shifts.labels[r, c]
-    sel = np.flatnonzero(label >= 0)
+    sel = np.flatnonzero(field.copied[r, c])
     if not len(sel):
         return rho
-    t = structure.shifts.shifts[label[sel]] * raster.cell
+    t = field.shift[r[sel], c[sel]] * raster.cell
     source = plane.points[sel] + t[:, :1] * raster.v + t[:, 1:] * raster.u
     valid = panorama.valid & (maps.surface_with == plane.surface)
     copy, weight = planeraster.sample_points_keeping_grain(source, panorama.rho, valid, frame=maps.frame)
-    coarse = planeraster.sample_raster(raster, structure.copies, plane.points[sel])
+    coarse = planeraster.sample_raster(raster, field.exemplar, source)
     ok = weight > 0.5
     out = rho.copy()
-    out[sel[ok]] += structure.detail * (copy[ok] - coarse[ok])
+    out[sel[ok]] += field.detail[r[sel], c[sel]][ok, None] * (copy[ok] - coarse[ok])
     return out

@@ -20,7 +20,7 @@ import numpy as np
 
 from .lines import interpolate_lines
 from .shift_map import NEIGHBOURS4, ShiftMap, candidate_shifts, lattice_shifts, shift_map
-from .texture import CancelFn, ProgressFn, SynthesisParams, clip_outliers, fill, membrane
+from .texture import CancelFn, ProgressFn, SynthesisParams, clip_outliers, fill_with_sources, membrane
 from .translations import DOMINANT, Translations, dominant_translations, relative_difference
 
 _TRANSLATIONS = 8  # of the texture's repeats, the best this many are labels (time grows with labels^2)
@@ -94,10 +94,20 @@ def structure_fill(image: np.ndarray, known: np.ndarray, hole: np.ndarray, *, fo
                          translations=translations, detail=1.0 if along is None else _PLANK_DETAIL)
 
 
+@dataclass(frozen=True)
+class Filled:
+    """A raster with its hole filled: `image` (H, W, C); `sources` (H, W, 2) the known pixel
+    (row, column) each pixel the order-independent synthesis filled copies, -1 elsewhere; and
+    the structure fill where the texture repeats (None where it does not)."""
+
+    image: np.ndarray
+    sources: np.ndarray
+    structure: StructureFill | None
+
+
 def fill_structured(image: np.ndarray, known: np.ndarray, hole: np.ndarray, params: SynthesisParams, *,
                     structure: bool = True, footprint: np.ndarray | None = None, seed: int = 0,
-                    progress: ProgressFn | None = None, cancel: CancelFn | None = None
-                    ) -> tuple[np.ndarray, StructureFill | None]:
+                    progress: ProgressFn | None = None, cancel: CancelFn | None = None) -> Filled:
     """`image` with its `hole` filled: composed from shifted copies where the texture repeats
     (with `structure`), the rest by the order-independent synthesis (`texture.fill`, which
     raises `DimredError` on too little exemplar). `progress(level, preview)` gets the composed
@@ -109,14 +119,16 @@ def fill_structured(image: np.ndarray, known: np.ndarray, hole: np.ndarray, para
     # are read from the panorama itself they score 0.44 and 0.60 composed, against 0.16 and 0.55
     # per pixel, with less object and shadow error (0.131 and 0.212, against 0.142 and 0.225).
     got = structure_fill(image, known, hole, footprint=footprint, seed=seed) if structure else None
-    if got is None:
-        return fill(image, known, hole, params, seed=seed, progress=progress, cancel=cancel), None
-    rest = hole & ~got.covered
-    if not rest.any():
-        return got.image, got
-    if progress is not None:
+    rest = hole if got is None else hole & ~got.covered
+    if got is not None and not rest.any():
+        return Filled(got.image, np.full((*hole.shape, 2), -1, np.int64), got)
+    if got is not None and progress is not None:
         progress(-1, got.image)
-    return fill(got.image, known | (hole & ~rest), rest, params, seed=seed, progress=progress, cancel=cancel), got
+    start, constraint = (image, known) if got is None else (got.image, known | (hole & ~rest))
+    out, sources = fill_with_sources(start, constraint, rest, params, seed=seed, progress=progress, cancel=cancel)
+    # the composed pixels constrain the synthesis but are no photograph to read detail from
+    photographed = known[np.maximum(sources[..., 0], 0), np.maximum(sources[..., 1], 0)] & (sources[..., 0] >= 0)
+    return Filled(out, np.where(photographed[..., None], sources, -1), got)
 
 
 def _plank_axis(image: np.ndarray, known: np.ndarray, hole: np.ndarray) -> int | None:

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
@@ -102,7 +103,13 @@ ProgressFn = Callable[[int, np.ndarray], None]
 CancelFn = Callable[[], bool]
 
 
-def fill(
+def fill(image: np.ndarray, known: np.ndarray, hole: np.ndarray, params: SynthesisParams = SynthesisParams(),
+         **options: Any) -> np.ndarray:
+    """`image` (H, W, C) with the `hole` pixels synthesised: `fill_with_sources`'s image."""
+    return fill_with_sources(image, known, hole, params, **options)[0]
+
+
+def fill_with_sources(
     image: np.ndarray,
     known: np.ndarray,
     hole: np.ndarray,
@@ -113,8 +120,10 @@ def fill(
     seed: int = 0,
     progress: ProgressFn | None = None,
     cancel: CancelFn | None = None,
-) -> np.ndarray:
-    """`image` (H, W, C) with the `hole` pixels synthesised; every other pixel is returned unchanged.
+) -> tuple[np.ndarray, np.ndarray]:
+    """`image` (H, W, C) with the `hole` pixels synthesised; every other pixel is returned
+    unchanged. And (H, W, 2) the exemplar pixel (row, column) each hole pixel copies
+    (`OrderIndependentSynthesis.sources`), -1 elsewhere.
 
     `known` pixels constrain the fill (a pixel in both masks counts as hole); pixels in neither
     mask are left out of all distances and never copied. The
@@ -132,7 +141,7 @@ def fill(
     out = synth.preview(0)
     if progress is not None:
         progress(0, out)
-    return out
+    return out, synth.sources()
 
 
 class OrderIndependentSynthesis:
@@ -209,6 +218,15 @@ class OrderIndependentSynthesis:
         out = self._image.copy()
         out[self._hole0] = values[self._hole0]
         return out
+
+    def sources(self) -> np.ndarray:
+        """(H, W, 2) the exemplar pixel (row, column) at the centre of the window each hole pixel
+        of the finest level copies, -1 elsewhere (computes the level). The seam correction comes
+        on top of the copy."""
+        g = self._gens[0]
+        self._ensure(0, g, self._hole[0])
+        src = self._src[0][g]
+        return np.where((src >= 0)[..., None], self._ex[0].pos[np.maximum(src, 0)], -1)
 
     def _seam_field(self, l: int) -> np.ndarray:
         """What `smooth_seams` adds to level l (0 outside the hole): the mismatch between each known

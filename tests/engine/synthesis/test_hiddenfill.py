@@ -54,3 +54,16 @@ def test_the_same_seed_fills_the_same_and_the_mean_stands_in_for_a_tiny_exemplar
     c = fill_surface(PanoramaReflectance(rho, few, panorama_maps), floor, _options())
     assert not c.synthesised
     assert np.allclose(c.rho, c.rho[0]) and np.isfinite(c.rho).all()
+
+
+def test_a_synthesised_fill_keeps_the_photographs_fine_detail():
+    """A plain floor whose pixels carry independent grain: the per-pixel synthesis on the
+    raster (cells of about a pixel) averages some of it away; the photograph's own detail,
+    read at each cell's source, brings the fill's spread back to the floor's."""
+    panorama_maps, _, valid, floor, _ = setup()
+    grain = 0.5 + 0.05 * np.random.default_rng(0).standard_normal((WIDTH // 2, WIDTH, 1)) * np.ones(3)
+    options = FillOptions(cell=0.01, margin=1.5, synthesis=SynthesisParams(), structure=False)
+    got = fill_surface(PanoramaReflectance(grain, valid, panorama_maps), floor, options)
+    assert got.synthesised and got.structured == 0
+    assert 0.8 * 0.05 < got.rho[:, 0].std() < 1.25 * 0.05
+    assert abs(got.rho[:, 0].mean() - 0.5) < 0.01

@@ -105,8 +105,9 @@ def test_planks_whose_grain_repeats_within_a_few_cells_are_composed():
     seen = np.where(hole[..., None], 0, truth)
     best = dominant_translations(seen, ~hole, hole).shifts[0]
     assert best[0] == 0 and 0 < abs(best[1]) < 4 * SynthesisParams().neighbourhood
-    composed, got = fill_structured(seen, ~hole, hole, SynthesisParams())
-    per_pixel, _ = fill_structured(seen, ~hole, hole, SynthesisParams(), structure=False)
+    filled = fill_structured(seen, ~hole, hole, SynthesisParams())
+    composed, got = filled.image, filled.structure
+    per_pixel = fill_structured(seen, ~hole, hole, SynthesisParams(), structure=False).image
     assert got is not None and got.covered[hole].all()
     assert _band_pass_correlation(composed, truth, hole) >= 0.7
     assert _band_pass_correlation(got.copies, truth, hole) > _band_pass_correlation(per_pixel, truth, hole) + 0.02

@@ -4,7 +4,14 @@ import numpy as np
 import pytest
 
 from addon.errors import Cancelled, DimredError
-from addon.synthesis.texture import OrderIndependentSynthesis, SynthesisParams, fill, neighbourhoods, pyramid
+from addon.synthesis.texture import (
+    OrderIndependentSynthesis,
+    SynthesisParams,
+    fill,
+    fill_with_sources,
+    neighbourhoods,
+    pyramid,
+)
 
 
 def _stripes(size=96, period=8, seed=0):
@@ -214,3 +221,14 @@ def test_progress_goes_coarse_to_fine_with_full_size_previews():
     # each finer level adds detail: the preview's high-pass energy in the hole grows
     detail = [_highpass_std(preview, hole) for _, preview in seen]
     assert detail[0] < detail[-1] and detail[-2] < detail[-1]
+
+
+def test_sources_are_the_known_pixels_each_hole_pixel_copies():
+    img = _noise(64)
+    hole = _square(64, 24, 40)
+    out, sources = fill_with_sources(img, ~hole, hole, SynthesisParams(smooth_seams=False), seed=2)
+    assert np.array_equal(sources[..., 0] >= 0, hole)
+    ys, xs = sources[hole].T
+    assert not hole[ys, xs].any()
+    np.testing.assert_array_equal(out[hole], img[ys, xs])
+    np.testing.assert_array_equal(out, fill(img, ~hole, hole, SynthesisParams(smooth_seams=False), seed=2))
