@@ -38,7 +38,8 @@ class StructureFill:
     """`image` with the covered hole pixels composed and blended (on planks: interpolated along
     them); `copies` (H, W, C) what the shift map copied there, `shifts` the shift map behind it.
     `detail` weighs the photograph's own detail that a lookup finer than the raster adds to
-    `image`: the copy read from the photograph minus `copies` (`plane_fill`)."""
+    `image` there: the copy read from the photograph minus the same copy in the raster
+    (`plane_fill`)."""
 
     image: np.ndarray
     copies: np.ndarray
@@ -109,9 +110,10 @@ def fill_structured(image: np.ndarray, known: np.ndarray, hole: np.ndarray, para
                     structure: bool = True, footprint: np.ndarray | None = None, seed: int = 0,
                     progress: ProgressFn | None = None, cancel: CancelFn | None = None) -> Filled:
     """`image` with its `hole` filled: composed from shifted copies where the texture repeats
-    (with `structure`), the rest by the order-independent synthesis (`texture.fill`, which
-    raises `DimredError` on too little exemplar). `progress(level, preview)` gets the composed
-    image first (level -1) where the synthesis has more to do, then the synthesis's levels."""
+    (with `structure`), the rest by the order-independent synthesis (`texture.fill_with_sources`,
+    which raises `DimredError` on too little exemplar); and where each pixel was copied from.
+    `progress(level, preview)` gets the composed image first (level -1) where the synthesis has
+    more to do, then the synthesis's levels."""
     # Composed whatever the period of the repeats. Checkers of 17 cells (rotated_world at
     # 256x128) and 24 cells (far_dark_box at 1024x512) came out 0.98 and 0.79 in structure,
     # against 0.95 and 0.67 per pixel. Planks whose wood grain matches itself every 7 cells along
