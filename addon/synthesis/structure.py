@@ -28,9 +28,10 @@ _SHORT_SHIFTS = (2, 4, 8)  # cells: what a plank changes by along its length and
 _PLANK_ANISOTROPY = 0.8  # planks: the texture changes along one axis at most this share of across it
 _LINE_ENDS = 6  # cells averaged at each visible end of a line along the planks (3: -0.02-0.07 in structure)
 # The copies' detail finer than the raster, on planks: with the raster's own share of it gone
-# from the interpolated lines, the detail ratio was 0.66-0.79 at 1024x512 with weight 1, 0.81-0.99
-# with 1.3, for 0.01-0.03 of structure.
-_PLANK_DETAIL = 1.3
+# from the interpolated lines, the detail ratio was 0.66-0.79 at 1024x512 with weight 1, 0.80-0.99
+# with 1.3, 0.88-1.08 with 1.45 (centred in its bound on six plank floors), for 0.02-0.04 of
+# structure against weight 1.
+_PLANK_DETAIL = 1.45
 
 
 @dataclass(frozen=True)
