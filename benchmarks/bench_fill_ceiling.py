@@ -50,8 +50,7 @@ def _nearest_seen(points: np.ndarray, sign: int, mask: np.ndarray, spec: SceneSp
     steps = sign * STEP * np.arange(1, int(REACH / STEP) + 1)
     moved = points[None] + steps[:, None, None] * np.array([1.0, 0.0, 0.0])
     u, v = latlong.direction_to_uv(moved)
-    col = np.clip((u * w).astype(np.int64), 0, w - 1)
-    row = np.clip(((1.0 - v) * h).astype(np.int64), 0, h - 1)
+    row, col = latlong.uv_to_pixel(u, v, w, h)
     x = moved[..., 0] + spec.probe[0]
     seen = ~mask[row, col] & (x > spec.room.lo[0]) & (x < spec.room.hi[0])
     first = seen.argmax(axis=0)

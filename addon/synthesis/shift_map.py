@@ -49,7 +49,7 @@ def candidate_shifts(translations: np.ndarray, hole: np.ndarray, *, along: int =
     each jittered by up to 15 % as the `seed` draws. The axis shifts continue a plank or a tile
     row from its visible ends whatever the lengths of the planks, which the translations alone
     cannot when their shades differ."""
-    extent = _extent(hole)
+    extent = hole_extent(hole)
     jitter = 1.0 + 0.15 * (2 * np.random.default_rng(seed).random(along) - 1) if seed else np.ones(along)
     lengths = np.unique(np.maximum(np.rint(extent * 1.5 ** (np.arange(along) - along + 2) * jitter), 2
                                    ).astype(np.int64))
@@ -74,7 +74,7 @@ def lattice_shifts(translations: np.ndarray, image: np.ndarray, known: np.ndarra
     base = np.concatenate([base, -base])
     i, j = np.triu_indices(len(base), 1)
     lattice = np.unique(np.concatenate([base, base[i] + base[j], 2 * base]), axis=0)
-    extent = _extent(hole)
+    extent = hole_extent(hole)
     length = np.hypot(*lattice.T)
     lattice = lattice[(length >= min_shift) & (length <= max(1.5 * extent, np.hypot(*base.T).max()))]
     score = relative_difference(image, known, hole, lattice)
@@ -90,7 +90,7 @@ def lattice_shifts(translations: np.ndarray, image: np.ndarray, known: np.ndarra
     return np.asarray(chosen, np.int64).reshape(-1, 2)
 
 
-def _extent(hole: np.ndarray) -> int:
+def hole_extent(hole: np.ndarray) -> int:
     """The hole's bounding box's longer side, in cells."""
     ys, xs = np.nonzero(hole)
     return max(int(np.ptp(ys)), int(np.ptp(xs)), 1) + 1

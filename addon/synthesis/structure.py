@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .lines import interpolate_lines
-from .shift_map import NEIGHBOURS4, ShiftMap, candidate_shifts, lattice_shifts, shift_map
+from .shift_map import NEIGHBOURS4, ShiftMap, candidate_shifts, hole_extent, lattice_shifts, shift_map
 from .texture import CancelFn, ProgressFn, SynthesisParams, clip_outliers, fill_with_sources, membrane
 from .translations import DOMINANT, Translations, dominant_translations, relative_difference
 
@@ -37,13 +37,12 @@ _PLANK_DETAIL = 1.45
 @dataclass(frozen=True)
 class StructureFill:
     """`image` with the covered hole pixels composed and blended (on planks: interpolated along
-    them); `copies` (H, W, C) what the shift map copied there, `shifts` the shift map behind it.
+    them); `shifts` the shift map behind it (its `image`: what it copied there).
     `detail` weighs the photograph's own detail that a lookup finer than the raster adds to
     `image` there: the copy read from the photograph minus the same copy in the raster
     (`plane_fill`)."""
 
     image: np.ndarray
-    copies: np.ndarray
     shifts: ShiftMap
     translations: Translations
     detail: float = 1.0
@@ -92,7 +91,7 @@ def structure_fill(image: np.ndarray, known: np.ndarray, hole: np.ndarray, *, fo
         fixed = weight > 0
         correction = membrane(clip_outliers(values, fixed), fixed, blended) if fixed.any() else 0.0
         out[blended] = (composed.image + correction)[blended]
-    return StructureFill(image=out.astype(np.float32), copies=composed.image, shifts=composed,
+    return StructureFill(image=out.astype(np.float32), shifts=composed,
                          translations=translations, detail=1.0 if along is None else _PLANK_DETAIL)
 
 
@@ -143,9 +142,7 @@ def _plank_axis(image: np.ndarray, known: np.ndarray, hole: np.ndarray) -> int |
     of it: a narrower ring can miss a tiling's grout lines along one axis altogether."""
     steps = np.array(_SHORT_SHIFTS)
     shifts = np.concatenate([np.stack([steps, 0 * steps], axis=1), np.stack([0 * steps, steps], axis=1)])
-    ys, xs = np.nonzero(hole)
-    ring = max(int(np.ptp(ys)), int(np.ptp(xs))) + 1
-    score = relative_difference(image, known, hole, shifts, ring=ring)
+    score = relative_difference(image, known, hole, shifts, ring=hole_extent(hole))
     rows, columns = float(score[:len(steps)].sum()), float(score[len(steps):].sum())
     if not np.isfinite(rows + columns) or min(rows, columns) > _PLANK_ANISOTROPY * max(rows, columns):
         return None

@@ -110,7 +110,7 @@ def test_planks_whose_grain_repeats_within_a_few_cells_are_composed():
     per_pixel = fill_structured(seen, ~hole, hole, SynthesisParams(), structure=False).image
     assert got is not None and got.covered[hole].all()
     assert _band_pass_correlation(composed, truth, hole) >= 0.7
-    assert _band_pass_correlation(got.copies, truth, hole) > _band_pass_correlation(per_pixel, truth, hole) + 0.02
+    assert _band_pass_correlation(got.shifts.image, truth, hole) > _band_pass_correlation(per_pixel, truth, hole) + 0.02
 
 
 def test_mean_follows_surroundings_under_a_brightness_step():
@@ -133,8 +133,8 @@ def test_same_seed_same_fill_other_seed_other_fill_of_the_same_quality(texture, 
     a, b = (structure_fill(seen, ~hole, hole, seed=1) for _ in range(2))
     c = structure_fill(seen, ~hole, hole, seed=2)
     np.testing.assert_array_equal(a.image, b.image)
-    np.testing.assert_array_equal(a.copies, b.copies)
-    assert not np.array_equal(a.copies[hole], c.copies[hole])
+    np.testing.assert_array_equal(a.shifts.image, b.shifts.image)
+    assert not np.array_equal(a.shifts.image[hole], c.shifts.image[hole])
     assert min(_band_pass_correlation(a.image, truth, hole), _band_pass_correlation(c.image, truth, hole)) >= least
 
 
@@ -258,6 +258,6 @@ def test_each_plank_keeps_its_own_shade_across_the_hole(transpose):
         truth, hole, inner = truth.transpose(1, 0, 2), hole.T, inner.T
     got = structure_fill(np.where(hole[..., None], 0, truth), ~hole, hole)
     assert got.covered[hole].all() and got.detail == structure._PLANK_DETAIL
-    interpolated, copied = (float(np.abs(a - truth)[inner].mean()) for a in (got.image, got.copies))
+    interpolated, copied = (float(np.abs(a - truth)[inner].mean()) for a in (got.image, got.shifts.image))
     assert interpolated < 0.5 * copied
     assert structure_fill(np.where(hole[..., None], 0, _tiles()), ~hole, hole).detail == 1.0
