@@ -42,6 +42,10 @@ class Params:
     # their lines run on through the hole; False leaves all to the per-pixel synthesis
     synth_structure: bool = True
     seed: int = 0  # the synthesis's random seed: the same seed gives the same fill
+    # where the removal brightens a surface (its shadow), weigh the photograph's detail down as
+    # far as the surface's noise, measured on the panorama, grows in its dark pixels: a relit
+    # contact shadow is otherwise speckled; False relights the noise with the light
+    match_relit_noise: bool = True
     # the light is solved on a copy of the panorama at most this wide; the full-resolution
     # panorama takes it from there (upsampled, refined where it is sharp, filled at its own size)
     working_width: int = 1024

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rendered import ground_truths, scene_list_arguments
+from rendered import ground_truths, print_table_header, scene_list_arguments
 from scenes.spec import SceneSpec
 
 SCENES = "demo,stool,warm_cylinder,oak_chair,walnut_crate,far_pouf"
@@ -84,10 +84,8 @@ def main() -> None:
     from addon.pipeline import remove_object
     from scenes import metrics
 
-    print(f"{args.width}x{args.width // 2}, structure over the object's floor pixels")
-    print()
-    print("| scene | floor pixels | median distance to seen floor m | copy | interpolation | ours |")
-    print("|---|---|---|---|---|---|")
+    print_table_header(f"{args.width}x{args.width // 2}, structure over the object's floor pixels",
+                       ["scene", "floor pixels", "median distance to seen floor m", "copy", "interpolation", "ours"])
     for gt in ground_truths(args):
         s, truth, mask = gt.spec, gt.truth, gt.mask
         if s.room.floor.pattern != "planks" or s.world_rotation_z:

@@ -12,22 +12,18 @@ from __future__ import annotations
 
 import numpy as np
 
-from rendered import ground_truths, scene_list_arguments
-
-SCENES = "basic_box,wall_contact,far_dark_box,tile_stool,stool,warm_cylinder,demo,oak_chair,walnut_crate,far_pouf"
+from rendered import FLOOR_SCENES, ground_truths, print_table_header, scene_list_arguments
 
 
 def main() -> None:
-    args = scene_list_arguments(__doc__, SCENES)
+    args = scene_list_arguments(__doc__, FLOOR_SCENES)
 
     from addon.pipeline import remove_object
     from scenes import metrics
 
-    print(f"{args.width}x{args.width // 2}, balanced, exact proxies")
-    print()
-    print("| scene | floor | structure-aware | structure | detail | mean | object + shadow | NaN | fill s "
-          "| synthesis s | hidden light s |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    print_table_header(f"{args.width}x{args.width // 2}, balanced, exact proxies",
+                       ["scene", "floor", "structure-aware", "structure", "detail", "mean", "object + shadow", "NaN",
+                        "fill s", "synthesis s", "hidden light s"])
     for gt in ground_truths(args):
         s = gt.spec
         for structure in (True, False):

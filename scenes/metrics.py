@@ -210,6 +210,27 @@ def hidden_region_scores(input: np.ndarray, edit: np.ndarray, truth: np.ndarray,
     }
 
 
+def relit_detail_ratio(input: np.ndarray, edit: np.ndarray, truth: np.ndarray, object_mask: np.ndarray, *,
+                       gain: float = 1.5) -> tuple[float, int]:
+    """How speckled the pixels the removal must brighten come out, and how many there are.
+
+    Over the pixels outside the object (dilated 1 px) that the truth shows at least `gain`
+    times as bright as the input (3 x 3 blurred luminance): the robust spread (median absolute
+    deviation) of the luminance against its 3 x 3 mean, relative to that mean, edit / truth.
+    1 = as much detail as the surface shows in full light; above 1 = the shadow's noise relit
+    with it. Raises ValueError if no pixel is brightened that much."""
+    y_in, y_tr = luminance(input), luminance(truth)
+    brightened = (box_blur3(y_tr) >= gain * box_blur3(y_in)) & ~dilate(np.asarray(object_mask, dtype=bool), 1)
+    if not brightened.any():
+        raise ValueError(f"no pixel outside the object is {gain} times brighter in the truth")
+
+    def spread(y: np.ndarray) -> float:
+        relative = ((y - box_blur3(y)) / np.maximum(box_blur3(y), 1e-30))[brightened]
+        return float(np.median(np.abs(relative - np.median(relative))))
+
+    return spread(luminance(edit)) / max(spread(y_tr), 1e-30), int(brightened.sum())
+
+
 def ghost_share(edit: np.ndarray, truth: np.ndarray, object_mask: np.ndarray, *, threshold: float = 0.3) -> float:
     """Share of the object's pixels (the true object's `object_mask`) where the edit is visibly
     off the truth: blurred |Y_edit - Y_truth| > `threshold` * blurred Y_truth. A proxy off the

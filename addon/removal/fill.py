@@ -156,11 +156,19 @@ def measured_reflectance(radiance: np.ndarray, e: np.ndarray, measured: np.ndarr
     return np.where(measured[:, None], np.clip(np.pi * radiance / np.maximum(e, 1e-30), 0.0, RHO_MAX), 0.0)
 
 
+def working_measured(solution: Solution) -> np.ndarray:
+    """(N,) bool: the hit pixels that measure a reflectance (not hidden, not a light, not too
+    dark against the median irradiance)."""
+    e_h = solution.e_h
+    e_ref = float(np.median(e_h @ LUMA))
+    return ~solution.traced.hidden_h & ~solution.room.pixels.emitter_h & ((e_h @ LUMA) > 1e-3 * e_ref)
+
+
 def _panorama_reflectance(solution: Solution, radiance: np.ndarray) -> PanoramaReflectance:
     """rho = pi L / E wherever a pixel measures it (not hidden, not a light, not too dark), from
     the hit pixels' radiance L (N, 3); and the surfaces every pixel sees with the object and
     without it."""
-    traced, room, e_h = solution.traced, solution.room, solution.e_h
+    traced, e_h = solution.traced, solution.e_h
     keys = solution.target.surface_key
     n = traced.height * traced.width
     shape = (traced.height, traced.width)
@@ -170,8 +178,7 @@ def _panorama_reflectance(solution: Solution, radiance: np.ndarray) -> PanoramaR
     surface_without = np.where(tri_without >= 0, keys[np.maximum(tri_without, 0)], -1)
     maps = PanoramaMaps(surface_with.reshape(shape), traced.hits.distance, surface_without.reshape(shape),
                         traced.behind.distance_without.reshape(shape), traced.hidden_map)
-    e_ref = float(np.median(e_h @ LUMA))
-    measured = ~traced.hidden_h & ~room.pixels.emitter_h & ((e_h @ LUMA) > 1e-3 * e_ref)
+    measured = working_measured(solution)
     rho = np.zeros((n, 3))
     rho[traced.hp] = measured_reflectance(radiance, e_h, measured)
     valid = np.zeros(n, dtype=bool)

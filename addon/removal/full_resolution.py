@@ -25,6 +25,7 @@ from .compose import ratio_change, reference_irradiance
 from .fill import Revealed, fill_hidden, hidden_light, hidden_planes, measured_reflectance, surface_footprint
 from .local import Receiving, light_at
 from .object_window import ObjectWindow, object_window
+from .relit_noise import relit_noise_stage
 from .solution import Solution
 from .working_maps import Cells, WorkingMaps, cells, neighbours, surfaces_seen, working_maps
 
@@ -75,14 +76,20 @@ def full_resolution(solution: Solution, hdri: np.ndarray, rep: Report, callbacks
         _refine(solution, refine, hdri, difference, window, window_e, e_ref, rep, callbacks)
     hidden_mask = np.zeros(full, dtype=bool)
     if window is None:
+        rep.skip("relit_noise", "the object is not visible from the probe centre: no window to measure noise in")
         rep.skip("synthesis", "the object is not visible from the probe centre: no hidden region to fill")
         return FullResolution(difference, hidden_mask, True)
     rows, cols = _window_pixels(window)
     hidden_mask[rows, cols] = window.hidden
+    surfaces = _window_surfaces(solution, window, window_e, e_ref)
+    radiance = np.maximum(hdri[rows, cols], 0.0)
+    difference[rows, cols] = relit_noise_stage(radiance, difference[rows, cols],
+                                               np.where(surfaces.measured, surfaces.without, -1),
+                                               enabled=solution.params.match_relit_noise, rep=rep).change
     revealed = window.hidden & (window.tri >= 0)
     if revealed.any():
         with rep.stage("hidden_light"):
-            found = _revealed(solution, window, window_e, hdri, revealed, e_ref)
+            found = _revealed(solution, window, window_e, radiance, surfaces, revealed)
             light = hidden_light(solution, found, callbacks)
         with rep.stage("synthesis"):
             change = fill_hidden(solution, found, light, rep, callbacks)
@@ -322,28 +329,43 @@ def _refined_light(solution: Solution, pixel: np.ndarray, tri: np.ndarray, bary:
         window_e[wr[inside], wc[inside]] = light.e[inside]
 
 
-def _revealed(solution: Solution, window: ObjectWindow, window_e: np.ndarray, hdri: np.ndarray,
-              revealed: np.ndarray, e_ref: float) -> Revealed:
-    """The window's revealed pixels and its reflectance, at full resolution (float32: the
-    maps span millions of pixels)."""
-    frame = window.frame
-    rows, cols = _window_pixels(window)
-    radiance = np.maximum(hdri[rows, cols], 0.0)
+@dataclass(frozen=True)
+class _WindowSurfaces:
+    """Per window pixel: the surface key it sees without the object (-1 for none) and whether
+    it measures a reflectance (not hidden, not a light, not too dark)."""
+
+    without: np.ndarray
+    measured: np.ndarray
+
+
+def _window_surfaces(solution: Solution, window: ObjectWindow, window_e: np.ndarray, e_ref: float
+                     ) -> _WindowSurfaces:
+    """What the window's pixels see, for the noise match and the exemplar."""
     keys = solution.target.surface_key.astype(np.int32)
-    seen_tri = np.where(window.on_object, window.object_tri, window.tri)
-    surface_with = np.where(seen_tri >= 0, keys[np.maximum(seen_tri, 0)], -1)
-    del seen_tri
-    surface_without = np.where(window.tri >= 0, keys[np.maximum(window.tri, 0)], -1)
-    distance_with = np.where(window.on_object, window.object_distance, window.distance)
-    finite = np.isfinite(window.distance)
-    maps = PanoramaMaps(surface_with, np.where(np.isfinite(distance_with), distance_with, 0.0), surface_without,
-                        np.where(finite, window.distance, 0.0), window.hidden, frame=frame)
-    del distance_with
-    room_hit = finite & ~window.on_object
+    room_hit = np.isfinite(window.distance) & ~window.on_object
     emitter = np.zeros(window.hidden.shape, dtype=bool)
     patch, _, _ = solution.room.patches.lattice.locate(window.tri[room_hit], window.bary[room_hit].astype(np.float64))
     emitter[room_hit] = solution.room.emitter[patch]
     measured = ~window.hidden & room_hit & ~emitter & ((window_e @ LUMA.astype(np.float32)) > 1e-3 * e_ref)
+    return _WindowSurfaces(without=np.where(window.tri >= 0, keys[np.maximum(window.tri, 0)], -1), measured=measured)
+
+
+def _revealed(solution: Solution, window: ObjectWindow, window_e: np.ndarray, radiance: np.ndarray,
+              surfaces: _WindowSurfaces, revealed: np.ndarray) -> Revealed:
+    """The window's revealed pixels and its reflectance measured from its `radiance` (h, w, 3),
+    at full resolution (float32: the maps span millions of pixels)."""
+    frame = window.frame
+    rows, cols = _window_pixels(window)
+    keys = solution.target.surface_key.astype(np.int32)
+    seen_tri = np.where(window.on_object, window.object_tri, window.tri)
+    surface_with = np.where(seen_tri >= 0, keys[np.maximum(seen_tri, 0)], -1)
+    del seen_tri
+    distance_with = np.where(window.on_object, window.object_distance, window.distance)
+    finite = np.isfinite(window.distance)
+    maps = PanoramaMaps(surface_with, np.where(np.isfinite(distance_with), distance_with, 0.0), surfaces.without,
+                        np.where(finite, window.distance, 0.0), window.hidden, frame=frame)
+    del distance_with
+    measured = surfaces.measured
     rho = measured_reflectance(radiance.reshape(-1, 3), window_e.reshape(-1, 3), measured.ravel())
     rho = rho.reshape(radiance.shape).astype(np.float32, copy=False)
     tri = window.tri[revealed].astype(np.int64)

@@ -23,19 +23,20 @@ from ..scene import SceneData
 from ..segmentation.seen import SeenObject, seen_object
 from ..segmentation.user_mask import UserMask
 from .compose import compose
-from .fill import fill_hidden, hidden_light, working_revealed
+from .fill import fill_hidden, hidden_light, working_measured, working_revealed
 from .first_order import first_order
 from .full_resolution import full_resolution
 from .local import local_light
 from .occlusion import occluders
 from .propagation import propagate_change
+from .relit_noise import relit_noise_stage
 from .room import solve_room
 from .solution import Solution
 from .target import Target, object_index, prepare
 from .trace import Traced, trace
 from .working import downsample, working_size
 
-STAGES = 10  # the stages a removal reports progress for
+STAGES = 11  # the stages a removal reports progress for
 
 
 @dataclass(frozen=True)
@@ -124,11 +125,12 @@ def finish(solution: Solution, rep: Report, callbacks: RunCallbacks = NO_CALLBAC
     revealed = traced.behind.revealed
     with rep.stage("compose"):
         d_h = compose(solution, rep)
+    d_h = _quiet_working(solution, d_h, rep)
 
     def difference_image(d_revealed: np.ndarray) -> np.ndarray:
         d = d_h.copy()
         d[revealed] = d_revealed
-        return _difference_image(traced, d)
+        return _hit_image(traced, d)
 
     if len(revealed):
         show = None if callbacks.preview is None else lambda d_revealed: callbacks.show(difference_image(d_revealed))
@@ -171,7 +173,7 @@ def remove(scene: SceneData, object_name: str, *, planes: list[str] | tuple[str,
         working = replace(scene, hdri=downsample(scene.hdri, *size))
     solution = solve(working, object_name, planes, params, rep, callbacks, seen=seen)
     if callbacks.preview is not None:
-        callbacks.show(_difference_image(solution.traced, compose(solution, Report())))
+        callbacks.show(_hit_image(solution.traced, compose(solution, Report())))
     return finish_full_size(solution, scene.hdri, rep, callbacks)
 
 
@@ -184,8 +186,21 @@ def finish_full_size(solution: Solution, hdri: np.ndarray, rep: Report, callback
                          seen=solution.seen)
 
 
-def _difference_image(traced: Traced, d_h: np.ndarray) -> np.ndarray:
-    """(H, W, 3) float32 image of a change (N, 3) of the hit pixels."""
+def _quiet_working(solution: Solution, d_h: np.ndarray, rep: Report) -> np.ndarray:
+    """The hit pixels' change (N, 3), the relit pixels' noise matched to their surface's
+    (`relit_noise`)."""
+    traced = solution.traced
+    measured = working_measured(solution)
+    surface = np.full(traced.height * traced.width, -1, dtype=np.int64)
+    surface[traced.hp[measured]] = solution.target.surface_key[traced.tri_h[measured]]
+    quiet = relit_noise_stage(_hit_image(traced, traced.panorama_rows(solution.hdri)),
+                              _hit_image(traced, d_h), surface.reshape(traced.height, traced.width),
+                              enabled=solution.params.match_relit_noise, rep=rep)
+    return quiet.change.reshape(-1, 3)[traced.hp]
+
+
+def _hit_image(traced: Traced, rows: np.ndarray) -> np.ndarray:
+    """(H, W, 3) float32 image of values (N, 3) of the hit pixels (0 elsewhere)."""
     image = np.zeros((traced.height * traced.width, 3), dtype=np.float32)
-    image[traced.hp] = d_h
+    image[traced.hp] = rows
     return image.reshape(traced.height, traced.width, 3)

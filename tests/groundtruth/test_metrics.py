@@ -178,3 +178,17 @@ def test_ghost_share_counts_the_object_pixels_left_visibly_wrong() -> None:
     assert M.ghost_share(edit, truth, mask, threshold=0.9) == 0.0
     with pytest.raises(ValueError):
         M.ghost_share(edit, truth, np.zeros_like(mask))
+
+
+def test_relit_detail_ratio_sees_a_shadow_relit_with_its_noise() -> None:
+    inp, truth, mask, shadow = _scene(3)
+    rng = np.random.default_rng(4)
+    noisy = inp.copy()
+    noisy[shadow] += 0.05 * rng.standard_normal((int(shadow.sum()), 3))  # the dark pixels' own noise
+    relit_noise = noisy.copy()
+    relit_noise[shadow] /= 0.6  # relit, noise and all
+    ratio, pixels = M.relit_detail_ratio(noisy, relit_noise, truth, mask)
+    assert ratio > 1.5 and 0 < pixels <= shadow.sum()
+    assert M.relit_detail_ratio(noisy, truth, truth, mask)[0] == pytest.approx(1.0)
+    with pytest.raises(ValueError, match="brighter"):
+        M.relit_detail_ratio(truth, truth, truth, mask)
