@@ -29,6 +29,7 @@ _BINS = np.array([1.05, 1.25, 1.5, 2.0, 3.0, np.inf])  # gains the raised pixels
 _MIN_PIXELS = 50  # pixels a gain bin, or a surface's reference, needs to be counted
 _MAX_REFERENCE = 1 << 18  # reference pixels measured per surface, at most (an even subsample)
 _MAX_GROWTH = 3.0
+_NEGLIGIBLE = 0.01  # k (g - 1) below this weighs the detail by more than 0.995: the pixel is left
 _MAD_TO_SD = 1.4826  # the median absolute deviation of a normal distribution, in standard deviations
 
 
@@ -71,15 +72,18 @@ def quiet_relit(radiance: np.ndarray, change: np.ndarray, surface: np.ndarray) -
     growth: dict[int, float] = {}
     change = change.copy()
     quieted = 0
+    measurable = usable & (gain >= _BINS[0])
     # Only surfaces with enough pixels brightened measurably can tell their noise's growth.
-    keys, counts = np.unique(surface[usable & (gain >= _BINS[0])], return_counts=True)
+    keys, counts = np.unique(surface[measurable], return_counts=True)
     for key in keys[counts >= _MIN_PIXELS]:
         own = usable & (surface == key)
-        raised = np.nonzero(own & (gain > 1.0))
-        k = _growth(after, gain, surface, own, raised)
+        k = _growth(after, gain, surface, own, np.nonzero(measurable & (surface == key)))
         if k <= 0.0:
             continue
         growth[int(key)] = k
+        raised = np.nonzero(own & (k * (gain - 1.0) > _NEGLIGIBLE))
+        if not len(raised[0]):
+            continue
         g = gain[raised]
         # Detail against the relit neighbours: across a shadow's edge the photograph's own
         # neighbours differ by the shadow, not by noise.
@@ -90,18 +94,14 @@ def quiet_relit(radiance: np.ndarray, change: np.ndarray, surface: np.ndarray) -
 
 
 def _growth(relit_y: np.ndarray, gain: np.ndarray, surface: np.ndarray, own: np.ndarray,
-            raised: tuple[np.ndarray, np.ndarray]) -> float:
-    """k of one surface from the relit luminance (`own` its usable pixels, `raised` those
-    brightened), 0 where too few pixels tell it. The reference is the surface's unchanged pixels
-    within the bounding box of those brightened measurably (the shadow, not the whole surface
-    the object took a little light from), grown by its own size: near enough to share their
-    texture's scale in the panorama."""
-    g = gain[raised]
-    which = np.digitize(g, _BINS) - 1  # -1 below the first bin: too close to 1 to tell
-    measurable = which >= 0
-    if np.count_nonzero(measurable) < _MIN_PIXELS:
-        return 0.0
-    rows, cols = raised[0][measurable], raised[1][measurable]
+            measurable: tuple[np.ndarray, np.ndarray]) -> float:
+    """k of one surface from the relit luminance (`own` its usable pixels, `measurable` those
+    brightened by a gain of at least the first bin's, enough of them), 0 where too few
+    unchanged pixels or bins tell it. The reference is the surface's unchanged pixels within
+    the bounding box of the measurable ones (the shadow, not the whole surface the object took
+    a little light from), grown by its own size: near enough to share their texture's scale in
+    the panorama."""
+    rows, cols = measurable
     h, w = relit_y.shape
     pad_r, pad_c = np.ptp(rows) + 1, np.ptp(cols) + 1
     box = (slice(max(rows.min() - pad_r, 0), min(rows.max() + pad_r + 1, h)),
@@ -117,7 +117,8 @@ def _growth(relit_y: np.ndarray, gain: np.ndarray, surface: np.ndarray, own: np.
     if v0 <= 0.0:
         return 0.0
     detail = _relative_detail(relit_y, surface, rows, cols)
-    g, which = g[measurable], which[measurable]
+    g = gain[measurable]
+    which = np.digitize(g, _BINS) - 1
     num = den = 0.0
     for b in range(len(_BINS) - 1):  # a handful of bins, each a vectorised sum
         sel = which == b
@@ -138,10 +139,33 @@ def _relative_detail(y: np.ndarray, surface: np.ndarray, rows: np.ndarray, cols:
 
 def _local_mean(image: np.ndarray, surface: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
     """(n, c) the mean of `image` (h, w, c) over each pixel's 3 x 3 neighbours on its own
-    surface (the pixel itself included): a crease or the object's edge is not detail."""
+    surface (the pixel itself included; the border clamped): a crease or the object's edge is
+    not detail. Most pixels see one surface all round and take a plain box mean, summed in
+    separable slices over their bounding box; the few beside another surface gather theirs."""
+    h, w = surface.shape
+    r0, c0 = int(rows.min()), int(cols.min())
+    bh, bw = int(rows.max()) + 1 - r0, int(cols.max()) + 1 - c0
+    rim_rows = np.clip(np.arange(r0 - 1, r0 + bh + 1), 0, h - 1)
+    rim_cols = np.clip(np.arange(c0 - 1, c0 + bw + 1), 0, w - 1)
+    box, keys = image[rim_rows][:, rim_cols], surface[rim_rows][:, rim_cols]
+    band = box[:-2] + box[1:-1] + box[2:]
+    mean = (band[:, :-2] + band[:, 1:-1] + band[:, 2:])[rows - r0, cols - c0] / 9.0
+    own = keys[1:-1, 1:-1]
+    one_surface = np.ones((bh, bw), dtype=bool)
+    for dr in range(3):
+        for dc in range(3):
+            one_surface &= keys[dr:dr + bh, dc:dc + bw] == own
+    mixed = np.flatnonzero(~one_surface[rows - r0, cols - c0])
+    if len(mixed):
+        mean[mixed] = _gathered_mean(image, surface, rows[mixed], cols[mixed])
+    return mean.astype(image.dtype, copy=False)
+
+
+def _gathered_mean(image: np.ndarray, surface: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+    """(n, c) `_local_mean` of scattered pixels, each neighbour looked up."""
     h, w = surface.shape
     own = surface[rows, cols]
-    total = np.zeros((len(rows), image.shape[2]), dtype=np.float64)
+    total = np.zeros((len(rows), image.shape[2]))
     count = np.zeros(len(rows))
     for dr in (-1, 0, 1):  # nine offsets, each over all the pixels at once
         r = np.clip(rows + dr, 0, h - 1)
@@ -150,7 +174,7 @@ def _local_mean(image: np.ndarray, surface: np.ndarray, rows: np.ndarray, cols: 
             same = surface[r, c] == own
             total += image[r, c] * same[:, None]
             count += same
-    return (total / count[:, None]).astype(image.dtype)
+    return total / count[:, None]
 
 
 def _robust_variance(values: np.ndarray) -> float:
