@@ -77,8 +77,9 @@ def quiet_relit(radiance: np.ndarray, change: np.ndarray, surface: np.ndarray) -
     # Only surfaces with enough pixels brightened measurably can tell their noise's growth.
     keys, counts = np.unique(surface[measurable], return_counts=True)
     for key in keys[counts >= _MIN_PIXELS]:
-        own = usable & (surface == key)
-        k = _growth(after, gain, surface, own, np.nonzero(measurable & (surface == key)))
+        on_key = surface == key
+        own = usable & on_key
+        k = _growth(after, gain, surface, own, np.nonzero(measurable & on_key))
         if k <= 0.0:
             continue
         growth[int(key)] = k

@@ -193,8 +193,9 @@ def _quiet_working(solution: Solution, d_h: np.ndarray, rep: Report) -> np.ndarr
     measured = working_measured(solution)
     surface = np.full(traced.height * traced.width, -1, dtype=np.int64)
     surface[traced.hp[measured]] = solution.target.surface_key[traced.tri_h[measured]]
-    quiet = relit_noise_stage(_hit_image(traced, traced.panorama_rows(solution.hdri)),
-                              _hit_image(traced, d_h), surface.reshape(traced.height, traced.width),
+    # The panorama as it is: the pixels that hit nothing have surface -1 and are never read.
+    quiet = relit_noise_stage(np.asarray(solution.hdri, np.float32), _hit_image(traced, d_h),
+                              surface.reshape(traced.height, traced.width),
                               enabled=solution.params.match_relit_noise, rep=rep)
     return quiet.change.reshape(-1, 3)[traced.hp]
 
