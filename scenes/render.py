@@ -3,7 +3,9 @@
 Each pair lives in `.cache/groundtruth/<spec.key()>/` at the repository root (git-ignored):
 `input.exr`, `truth.exr`, `mask.npy`, `scene.blend`, `spec.json`, `times.json`. The render runs
 in a subprocess (`scenes.render_job`) and is moved into the cache only when complete, so an
-interrupted or failed render never leaves a partial entry behind.
+interrupted or failed render never leaves a partial entry behind. A pair whose truth another
+cached pair already holds (a relocation's: the same room without the object) copies it instead
+of rendering it again.
 """
 from __future__ import annotations
 
@@ -56,6 +58,9 @@ def _render_into_cache(spec: SceneSpec, paths: dict[str, Path], cache_root: Path
     work = Path(tempfile.mkdtemp(prefix=f"{spec.key()}.", suffix=".tmp", dir=cache_root))
     try:
         (work / FILES["spec"]).write_text(spec.to_json())
+        truth = _cached_truth(spec, cache_root)
+        if truth is not None:
+            shutil.copyfile(truth, work / FILES["truth"])
         _job(["pair", str(work)], f"render of {spec.name!r}", timeout)
         folder = paths["input"].parent
         try:
@@ -67,6 +72,24 @@ def _render_into_cache(spec: SceneSpec, paths: dict[str, Path], cache_root: Path
     finally:
         if work.exists():
             shutil.rmtree(work)
+
+
+def _cached_truth(spec: SceneSpec, cache_root: Path) -> Path | None:
+    """A cached pair's truth that is `spec`'s too (the same `truth_key`), else None: a
+    relocation's truth shares the room without the object with the pair it moves."""
+    want = spec.truth_key()
+    for folder in cache_root.iterdir():
+        paths = {k: folder / name for k, name in FILES.items()}
+        if not all(p.exists() for p in paths.values()):
+            continue
+        try:
+            cached = SceneSpec.from_json(paths["spec"].read_text())
+        except (ValueError, TypeError, KeyError):  # a spec of older fields: a stale folder
+            continue
+        # The folder's name is its spec's key under the present render code, or it is stale.
+        if folder.name == cached.key() and cached.truth_key() == want:
+            return paths["truth"]
+    return None
 
 
 def render_world(blend: str | Path, out_exr: str | Path,

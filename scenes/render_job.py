@@ -5,7 +5,8 @@ crashes stay out of the caller.
 the job writes there `input.exr` (with the object to remove), `truth.exr` (without it, same
 seed), `scene.blend` (the user's view of the scene: the proxy geometry, `ProbeCenter`, and a
 world showing input.exr), `mask.npy` (pixels whose centre direction from the probe sees the
-removed object) and `times.json` (wall and CPU seconds per render).
+removed object) and `times.json` (wall and CPU seconds per render). A `truth.exr` already in
+DIR is kept and not rendered.
 
 `python -m scenes.render_job world BLEND OUT.exr` renders only the world of a saved scene, as
 a user's panoramic camera at the probe centre sees it: rotation (90, 0, -90) degrees, one point
@@ -56,9 +57,10 @@ def run_pair(out: Path) -> None:
     times: dict[str, float] = {}
 
     write_exr(out / "input.exr", _timed_render(scene, out / "raw.exr", times, "input"))
-    removed.hide_render = True
-    write_exr(out / "truth.exr", _timed_render(scene, out / "raw.exr", times, "truth"))
-    removed.hide_render = False
+    if not (out / "truth.exr").exists():  # else `scenes.render` copied another pair's, the same
+        removed.hide_render = True
+        write_exr(out / "truth.exr", _timed_render(scene, out / "raw.exr", times, "truth"))
+        removed.hide_render = False
 
     set_environment_world(scene, str(out / "input.exr"), spec.world_rotation_z)
     scene["groundtruth_spec"] = spec.to_json()

@@ -146,9 +146,23 @@ class SceneSpec:
 
     def key(self) -> str:
         """Stable hash of every field, the render code and the bpy version (cache folder name)."""
-        h = hashlib.sha256(self.to_json().encode())
-        h.update(_render_fingerprint().encode())
-        return h.hexdigest()[:20]
+        return _hashed(self.to_json())
+
+    def truth_key(self) -> str:
+        """`key` of what the render without the removed object shows: the scene less that
+        object, whatever its name and place. Specs that differ only there (an object and the
+        same object moved) render the same truth, bit for bit: Cycles' random numbers depend
+        on the pixel, the sample and the seed, not on objects hidden from the render."""
+        d = self.to_dict()
+        d["objects"] = [o for o in d["objects"] if o["name"] != self.remove]
+        del d["name"], d["remove"]
+        return _hashed(json.dumps(d, sort_keys=True))
+
+
+def _hashed(text: str) -> str:
+    h = hashlib.sha256(text.encode())
+    h.update(_render_fingerprint().encode())
+    return h.hexdigest()[:20]
 
 
 def _tuples(d: dict[str, Any]) -> dict[str, Any]:

@@ -61,7 +61,7 @@ def main() -> int:
     paths = render_pair(scene)
     times = json.loads(paths["times"].read_text())
     print("  render seconds: " + ", ".join(
-        f"{k} {times[k]:.1f} ({times[k + '_cpu']:.0f} CPU)" for k in ("input", "truth", "mask")))
+        f"{k} {times[k]:.1f} ({times[k + '_cpu']:.0f} CPU)" for k in ("input", "truth", "mask") if k in times))
 
     OUT.mkdir(parents=True, exist_ok=True)
     # A failed run must not leave an older run's results looking current.

@@ -1,7 +1,8 @@
 """`dimred batch` on the ground-truth scenes as a pipeline runs it: 20 jobs (removals, several
 objects removed in order, relocations, alignments, one damaged .blend, one unknown object)
-through the command line with two workers, killed midway and run again, then the same file
-through a Dask scheduler with two workers started as processes.
+through the command line with two workers, killed midway and run again, then eight of them (one
+job of each kind and both bad ones) through a Dask scheduler with two workers started as
+processes.
 
 Every good job's difference image must be the single command line's, bit for bit (checked here
 for one job of each kind; `benchmarks/bench_batch.py --check` checks all), the bad jobs must
@@ -93,16 +94,24 @@ def test_the_batchs_results_are_the_single_command_lines(batch, tmp_path):
         assert records[job_id]["error"] == run.stderr.strip().splitlines()[-1]
 
 
+# One job of each kind and both bad ones: what the scheduler could change is where and in what
+# order jobs run, the same for every kind (the whole file takes a minute longer on two cores).
+FARM_JOBS = ("basic_box-balanced", "second_object-both", "rotated_world-floor", "seam-aligned", "stool-move",
+             "basic_box-align", "damaged", "unknown-object")
+
+
 @pytest.mark.slow
 def test_a_dask_scheduler_with_two_workers_gives_the_same_outputs(batch, tmp_path):
-    farm = tmp_path / "farm"
+    jobs_file, farm = tmp_path / "jobs.jsonl", tmp_path / "farm"
+    jobs_file.write_text("".join(json.dumps(j) + "\n" for j in batch["jobs"] if j["id"] in FARM_JOBS))
     with dask_cluster(2, tmp_path) as address:
-        run = cli("batch", str(batch["jobs_file"]), "--out", str(farm), "--scheduler", address)
+        run = cli("batch", str(jobs_file), "--out", str(farm), "--scheduler", address)
     assert run.returncode == 2, run.stderr[-3000:]
     local, remote = _differences(batch["out"]), _differences(farm)
-    assert len(local) == 16 and local.keys() == remote.keys()
-    for job_id, image in local.items():
-        assert np.array_equal(image, remote[job_id]), job_id
+    assert len(remote) == 5 and remote.keys() <= local.keys()
+    for job_id, image in remote.items():
+        assert np.array_equal(image, local[job_id]), job_id
     statuses = [(r["id"], r["status"], r["error"]) for r in json.loads((farm / "summary.json").read_text())["records"]]
     assert statuses == [(r["id"], r["status"], r["error"])
-                        for r in json.loads((batch["out"] / "summary.json").read_text())["records"]]
+                        for r in json.loads((batch["out"] / "summary.json").read_text())["records"]
+                        if r["id"] in FARM_JOBS]

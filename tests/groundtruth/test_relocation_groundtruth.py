@@ -26,8 +26,9 @@ from scenes.render import REPO, load_pair, render_pair
 
 BOUND = 0.4
 FAR_DAMAGE = 0.08
+# red_box, moved by 25 degrees and 0.8 of its distance, is checked with its colour below.
 CASES = [("basic_box", 40.0, 1.3), ("stool", 40.0, 1.3), ("rotated_world", -40.0, 1.3),
-         ("wall_contact", -40.0, 1.3), ("red_box", 25.0, 0.8), ("second_object", -40.0, 1.3),
+         ("wall_contact", -40.0, 1.3), ("second_object", -40.0, 1.3),
          ("bright_lamp", 40.0, 1.3), ("seam", 40.0, 1.3), ("nadir", 40.0, 1.3)]
 
 
@@ -66,10 +67,7 @@ def _relocated(spec: S.SceneSpec, yaw: float, scale: float, tmp_path) -> Relocat
     return Relocated(inp, empty, truth, old_mask, new_mask, edit, json.loads((out / "report.json").read_text()))
 
 
-@pytest.mark.slow
-@pytest.mark.parametrize("name, yaw, scale", CASES)
-def test_relocation_matches_the_render_at_the_new_place(name, yaw, scale, tmp_path):
-    r = _relocated(S.get(name), yaw, scale, tmp_path)
+def _assert_matches_the_render(name: str, yaw: float, scale: float, r: Relocated) -> None:
     region = M.relocation_region(r.input, r.truth, r.empty, r.old_mask, r.new_mask)
     ratio = M.relocation_error_ratio(r.input, r.edit, r.truth, region)
     far = M.far_damage(r.input, r.edit, r.truth, r.old_mask | r.new_mask, region=region)
@@ -79,6 +77,12 @@ def test_relocation_matches_the_render_at_the_new_place(name, yaw, scale, tmp_pa
     assert ratio <= BOUND
     assert far <= FAR_DAMAGE
     assert rel["yaw"] == yaw and rel["distance_scale"] == scale and rel["support"] == ["Floor"]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name, yaw, scale", CASES)
+def test_relocation_matches_the_render_at_the_new_place(name, yaw, scale, tmp_path):
+    _assert_matches_the_render(name, yaw, scale, _relocated(S.get(name), yaw, scale, tmp_path))
 
 
 @pytest.mark.slow
@@ -103,9 +107,10 @@ def test_a_move_the_constraint_forbids_is_refused(name, yaw, scale, expected, tm
 def test_an_object_moved_out_of_a_shadow_is_lit_at_its_new_place(tmp_path):
     """Thesis 5.2: the photograph shows the box in a cabinet's shadow; moved into the lamp's
     light its carried appearance must brighten as much as the render says, not keep the shadow.
-    The box is lit indirectly there, so the renders take 256 samples (at 64 their noise alone
-    is a third of the input's error)."""
-    r = _relocated(S.get("shadowed_box").with_render(samples=256), 40.0, 1.3, tmp_path)
+    The box is lit indirectly there, so the renders take 128 samples: at 64 their noise alone
+    is a third of the input's error; the edit's error is 0.37 of the input's at 128, 0.32 at
+    256 (which takes twice the render time)."""
+    r = _relocated(S.get("shadowed_box").with_render(samples=128), 40.0, 1.3, tmp_path)
     inp, empty, truth, old_mask, new_mask, edit = r.input, r.empty, r.truth, r.old_mask, r.new_mask, r.edit
     region = M.relocation_region(inp, truth, empty, old_mask, new_mask)
     ratio = M.relocation_error_ratio(inp, edit, truth, region)
@@ -122,8 +127,10 @@ def test_an_object_moved_out_of_a_shadow_is_lit_at_its_new_place(tmp_path):
 @pytest.mark.slow
 def test_a_red_box_moved_colours_the_floor_at_its_new_place(tmp_path):
     """The light the object reflects goes with it: around the red box's new place the floor's
-    colour must match the render's (the room without the box lacks that red tint)."""
+    colour must match the render's (the room without the box lacks that red tint). The move
+    must match the render at the new place as every other does."""
     r = _relocated(S.get("red_box"), 25.0, 0.8, tmp_path)
+    _assert_matches_the_render("red_box", 25.0, 0.8, r)
     inp, empty, truth, old_mask, new_mask, edit = r.input, r.empty, r.truth, r.old_mask, r.new_mask, r.edit
     both = old_mask | new_mask
     around = M.dilate(new_mask, 12) & ~M.dilate(both, 2)

@@ -112,6 +112,24 @@ def test_pair_files_and_linear_output(basic: S.SceneSpec) -> None:
     assert render_pair(basic) == paths  # cached
 
 
+def test_an_object_moved_keeps_the_truth_key() -> None:
+    base = S.get("basic_box")
+    moved = S.relocated(base, 40.0, 1.3)
+    assert moved.key() != base.key() and moved.truth_key() == base.truth_key()
+    assert base.with_render(samples=5).truth_key() != base.truth_key()
+    assert S.get("seam").truth_key() != base.truth_key()
+
+
+@pytest.mark.slow
+def test_a_moved_pair_takes_the_truth_of_the_pair_it_moves(basic: S.SceneSpec) -> None:
+    """Its truth is copied, not rendered again: the same file, bit for bit."""
+    inp, truth, mask = load_pair(basic)
+    moved = render_pair(S.relocated(basic, 40.0, 1.3))
+    assert "truth" not in json.loads(moved["times"].read_text())
+    assert np.array_equal(read_exr(moved["truth"]), truth)
+    assert not np.array_equal(read_exr(moved["input"]), inp) and not (np.load(moved["mask"]) == mask).all()
+
+
 @pytest.mark.slow
 def test_input_and_truth_differ_near_the_object_only(basic: S.SceneSpec) -> None:
     inp, truth, mask = load_pair(basic)
