@@ -135,6 +135,16 @@ def seen_object(hdri: np.ndarray, geo: Geometry, index: int, *, segment: bool = 
         else:
             seg = segment_object(image, proxy, band=band_px)
             _check_overlap(seg, proxy, name)
+            if _unclear(seg):
+                # Nothing there stands apart from its surroundings: a proxy over bare floor, or
+                # an object the photograph is too dark or noisy to show. Only a mask that paints
+                # the object in says which.
+                if mask is None or not mask.in_frame(frame, shape)[0].any():
+                    _refuse_unclear(name)
+                seg = None
+                if rep is not None:
+                    rep.warn(f"the photograph does not set '{name}' apart from its surroundings: its proxy's "
+                             "silhouette and the mask are filled")
     shown = proxy | _added(image, proxy, seg, band_px) if seg is not None else proxy.copy()
     if mask is not None:
         add, take = mask.in_frame(frame, shape)
@@ -228,13 +238,25 @@ def _added(image: np.ndarray, proxy: np.ndarray, seg: ObjectSegmentation, band: 
 
 def _check_overlap(seg: ObjectSegmentation, proxy: np.ndarray, name: str) -> None:
     shared = float((seg.object & proxy).sum()) / max(1, int(proxy.sum()))
-    unclear = seg.separation < _MIN_SEPARATION and seg.outline_contrast < _MIN_CONTRAST
-    if shared < _MIN_OVERLAP or unclear:
+    if shared < _MIN_OVERLAP:
         _refuse(name, shared)
+
+
+def _unclear(seg: ObjectSegmentation) -> bool:
+    return seg.separation < _MIN_SEPARATION and seg.outline_contrast < _MIN_CONTRAST
+
+
+_CHECK = "check that the right object is marked and that it stands where the panorama shows it"
 
 
 def _refuse(name: str, shared: float) -> None:
     raise DimredError(
         f"the proxy '{name}' does not lie over what the photograph shows there ({shared:.0%} of its silhouette "
-        "looks like an object): check that the right object is marked and that it stands where the "
-        "panorama shows it")
+        f"looks like an object): {_CHECK}")
+
+
+def _refuse_unclear(name: str) -> None:
+    raise DimredError(
+        f"the proxy '{name}' does not lie over what the photograph shows there (nothing there stands apart from "
+        f"its surroundings, by colour or by an edge along its outline): {_CHECK}; if it does and the photograph is "
+        "too dark or noisy to show it, paint a mask over it")

@@ -109,4 +109,28 @@ def test_a_proxy_over_no_object_is_refused_by_align_and_remove(tmp_path, capfd):
         out = tmp_path / command
         assert cli.main([command, blend, "--object", "Box", "--out", str(out), "--quality", "draft"]) == 2
         _, stderr = capfd.readouterr()
-        assert "does not lie over what the photograph shows" in stderr and not out.exists()
+        # Bare floor shows no object there: the message says so rather than a share of object.
+        assert ("does not lie over what the photograph shows there (nothing there stands apart from its surroundings"
+                in stderr and "paint a mask over it" in stderr and not out.exists())
+
+
+def test_a_mask_painted_over_what_stands_apart_from_nothing_is_filled(tmp_path, capfd):
+    # What the photograph cannot set apart (a dark or noisy picture, an object of the floor's
+    # colour; here bare floor) the artist's mask decides: the run goes on and says so.
+    blend = _room(tmp_path)
+    bpy.ops.wm.open_mainfile(filepath=blend)
+    box = bpy.data.objects["Box"]
+    box.matrix_world = Matrix.Translation((-1.7, 0.8, 0.0)) @ box.matrix_world
+    bpy.ops.wm.save_as_mainfile(filepath=blend)
+    mask = np.zeros((128, 256, 3), np.uint8)
+    write_png(tmp_path / "black.png", mask)
+    mask[64:] = 255  # the floor half of the panorama
+    write_png(tmp_path / "floor.png", mask)
+    removal = ["remove", blend, "--object", "Box", "--quality", "draft", "--mask"]
+    # A mask that only takes pixels away says nothing of where the object is.
+    assert cli.main([*removal, str(tmp_path / "black.png"), "--out", str(tmp_path / "black")]) == 2
+    assert "nothing there stands apart" in capfd.readouterr().err
+    assert cli.main([*removal, str(tmp_path / "floor.png"), "--out", str(tmp_path / "out")]) == 0
+    warnings = json.loads((tmp_path / "out" / "report.json").read_text())["warnings"]
+    expected = "the photograph does not set 'Box' apart from its surroundings: its proxy's silhouette and the mask are"
+    assert [w for w in warnings if w.startswith(expected)] == [expected + " filled"]
