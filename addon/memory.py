@@ -11,6 +11,7 @@ import os
 import sys
 
 from .errors import DimredError
+from .quality import PRESETS
 
 # Bytes per full-resolution pixel, measured on removals of 8192 x 4096 and 16384 x 8192
 # panoramas (peak resident memory against the pixel count: 2.3 and 4.7 GB at balanced, Blender
@@ -23,29 +24,46 @@ BAND_BYTES_PER_PIXEL = 8  # the hidden mask, per-pixel flags and the bands in fl
 #: panorama's size, per quality preset (measured as above: the intercept of peak memory against
 #: pixel count; final solves at twice the working width).
 SOLVE_BYTES = {"draft": 1_300_000_000, "balanced": 1_400_000_000, "final": 2_000_000_000}
+#: Bytes the solve adds per pixel of a working copy wider than its preset's: at 8192 x 4096,
+#: balanced solved at 512, 1024 and 2048 wide peaked at 1.50, 1.63 and 2.08 GiB
+#: (`bench_scale.py --working-widths`), 310-355 bytes a working pixel; the rest is a margin.
+WORKING_BYTES_PER_PIXEL = 400
 
 _GB = 1e9
 
 
-def required_bytes(width: int, height: int, *, quality: str) -> int:
-    """The memory a removal of a `width` x `height` panorama at `quality` needs at its peak."""
+def required_bytes(width: int, height: int, *, quality: str, working_width: int | None = None) -> int:
+    """The memory a removal of a `width` x `height` panorama at `quality` needs at its peak,
+    with the light solved at most `working_width` wide (default: the preset's)."""
     if quality not in SOLVE_BYTES:
         raise DimredError(f"unknown quality '{quality}': choose one of {', '.join(SOLVE_BYTES)}")
     per_pixel = INPUT_BYTES_PER_PIXEL + DIFFERENCE_BYTES_PER_PIXEL + BAND_BYTES_PER_PIXEL
-    return SOLVE_BYTES[quality] + per_pixel * int(width) * int(height)
+    solve = SOLVE_BYTES[quality]
+    if working_width is not None:
+        # A narrower copy than the preset's is not counted as a saving: the fixed part was
+        # measured at the preset's width only, and an estimate must not fall short.
+        wider = _working_pixels(width, working_width) - _working_pixels(width, PRESETS[quality].working_width)
+        solve += WORKING_BYTES_PER_PIXEL * max(0, wider)
+    return solve + per_pixel * int(width) * int(height)
 
 
-def check_fits(width: int, height: int, *, quality: str, available: int | None = None) -> None:
+def _working_pixels(width: int, working_width: int) -> int:
+    side = min(int(width), int(working_width))
+    return side * (side // 2)
+
+
+def check_fits(width: int, height: int, *, quality: str, working_width: int | None = None,
+               available: int | None = None) -> None:
     """DimredError unless a removal of a `width` x `height` panorama fits in `available` bytes
     (default: what `available_bytes` finds; nothing is refused where it finds nothing)."""
-    needed = required_bytes(width, height, quality=quality)
+    needed = required_bytes(width, height, quality=quality, working_width=working_width)
     if available is None:
         available = available_bytes()
     if available is not None and needed > available:
         raise DimredError(
             f"a {width}x{height} panorama needs about {needed / _GB:.1f} GB of memory at quality '{quality}' "
             f"but only {available / _GB:.1f} GB is available: close other programs or use a smaller copy "
-            "of the panorama"
+            "of the panorama" + ("" if working_width is None else " or a narrower working width")
         )
 
 

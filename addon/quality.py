@@ -48,7 +48,7 @@ class Params:
     match_relit_noise: bool = True
     # the light is solved on a copy of the panorama at most this wide; the full-resolution
     # panorama takes it from there (upsampled, refined where it is sharp, filled at its own size)
-    working_width: int = 1024
+    working_width: int = 1024  # even, at least MIN_WORKING_WIDTH
     refine_pixels: int = 200_000  # full-resolution pixels on sharp shadow edges given their own light, at most
     # the region to fill is segmented from the photograph in a band around the proxy's silhouette
     # this wide (a share of the object's angular size): wide enough for a proxy placed by eye a
@@ -58,6 +58,9 @@ class Params:
     # lacks the object's reflected light)
     insertion_passes: int = 2
 
+
+#: The narrowest working copy a run accepts: below it a room's objects are a few pixels wide.
+MIN_WORKING_WIDTH = 128
 
 #: The preset a run uses unless told otherwise (the command line's and the add-on's default).
 DEFAULT_QUALITY = "balanced"
@@ -89,9 +92,14 @@ def params_for(quality: str, **overrides) -> Params:
     if quality not in PRESETS:
         raise DimredError(f"unknown quality '{quality}': choose one of {', '.join(PRESETS)}")
     try:
-        return replace(PRESETS[quality], **overrides)
+        params = replace(PRESETS[quality], **overrides)
     except TypeError as exc:
         raise DimredError(f"unknown parameter: {exc}") from None
+    width = params.working_width
+    if isinstance(width, bool) or not isinstance(width, int) or width < MIN_WORKING_WIDTH or width % 2:
+        raise DimredError(f"working_width must be an even number of pixels, at least {MIN_WORKING_WIDTH}, "
+                          f"not {width!r}")
+    return params
 
 
 # The solver's accuracy knobs (not the synthesis's, not the relocation's passes).

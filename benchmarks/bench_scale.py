@@ -3,6 +3,7 @@
     .venv/bin/python benchmarks/bench_scale.py [--sizes 1024,2048,4096,8192,16384]
         [--splits 1,9,29,64] [--quality draft,balanced,final] [--engine] [--markdown]
         [--truth-sizes 2048] [--scene basic_box] [--width 1024] [--samples 8]
+        [--working-widths 512,1024,2048]
 
 Each row is one removal in a fresh process, measured from outside: wall seconds from its
 start to its exit and its peak resident memory (that child's rusage). By default the process
@@ -19,9 +20,11 @@ object's triangles into k^2 at --width (the same surface, so the same truth): k 
 give the box's 12, 972, 10092 and 49152 triangles. Each row's .blend (with the upsampled EXR
 as its world image, or the split mesh) is built once by a bpy subprocess and cached under
 .cache/bench_scale. The ratio columns divide by the row of the --width panorama with k = 1 of
-the same preset in the same run; the targets are 8K within 4x the 1K time and 3 GB, 16K
-within 8 GB, 49k triangles within 2x the 12-triangle time and memory. Timings on a shared
-machine are noisy: compare the rows of one run.
+the same preset (and working width) in the same run; --working-widths repeats each preset's
+rows with the light solved at those widths (`--working-width`), default the preset's own.
+The targets are 8K within 4x the 1K time and 3 GB, 16K within 8 GB, 49k triangles within 2x
+the 12-triangle time and memory. Timings on a shared machine are noisy: compare the rows of
+one run.
 """
 from __future__ import annotations
 
@@ -60,6 +63,10 @@ class Case:
     factor: int
     pair: dict[str, Path]
     folder: Path
+
+
+#: A preset's name and the working width it solves at (None: the preset's own).
+Preset = tuple[str, int | None]
 
 
 @dataclass(frozen=True)
@@ -165,7 +172,8 @@ def _engine(args: argparse.Namespace) -> None:
     scene = loaded(SceneData(hdri=None, rotation=data["rotation"], center=data["center"],
                              triangles=data["triangles"], tri_object=data["tri_object"],
                              object_names=[str(n) for n in data["object_names"]], hdri_path=str(data["hdri_path"])))
-    result = remove_object(scene, args.object, quality=args.quality)
+    overrides = {} if args.working_width is None else {"working_width": args.working_width}
+    result = remove_object(scene, args.object, quality=args.quality, **overrides)
     args.out.mkdir(parents=True, exist_ok=True)
     (args.out / "report.json").write_text(json.dumps(result.report))
     if args.difference:
@@ -184,8 +192,9 @@ def _measure(command: list[str], out: Path) -> Measured:
     return Measured(proc.returncode, time.perf_counter() - started, usage.ru_maxrss / 2**20, out / "result")
 
 
-def _run(case: Case, name: str, quality: str, engine: bool, folder: Path) -> Measured:
-    out = folder / f"{quality}-{case.width}-k{case.split}"
+def _run(case: Case, name: str, preset: Preset, engine: bool, folder: Path) -> Measured:
+    quality, working_width = preset
+    out = folder / f"{quality}-{working_width}-{case.width}-k{case.split}"
     if engine:
         command = [sys.executable, __file__, "--engine-child", str(case.folder), "--object", name,
                    "--quality", quality, "--out", str(out / "result")]
@@ -193,6 +202,7 @@ def _run(case: Case, name: str, quality: str, engine: bool, folder: Path) -> Mea
     else:
         command = [sys.executable, "-m", "addon.cli", "remove", str(case.folder / "scene.blend"), "--object", name,
                    "--out", str(out / "result"), "--quality", quality]
+    command += [] if working_width is None else ["--working-width", str(working_width)]
     return _measure(command, out)
 
 
@@ -205,10 +215,12 @@ def _error(case: Case, run: Measured, engine: bool) -> str:
     return f"{metrics.lighting_error_ratio(inp, edited, truth, mask):.3f}"
 
 
-def _cells(quality: str, engine: bool, case: Case, run: Measured, base: Measured) -> list[str]:
+def _cells(preset: Preset, engine: bool, case: Case, run: Measured, base: Measured) -> list[str]:
+    quality, working_width = preset
     panorama = f"{case.width}x{case.width // 2}"
     source = "render" if case.factor == 1 else f"upsampled x{case.factor}"
-    head = [quality, "engine" if engine else "cli", panorama, source]
+    label = quality if working_width is None else f"{quality}, solved at {working_width}"
+    head = [label, "engine" if engine else "cli", panorama, source]
     triangles = json.loads((case.folder / "case.json").read_text())["triangles"]
     if run.status:
         tail = (run.out.parent / "log.txt").read_text().strip().splitlines() or ["no output"]
@@ -245,10 +257,12 @@ def main() -> None:
     ap.add_argument("--splits", default="1,9,29,64", help="k: each of the object's triangles split into k^2")
     ap.add_argument("--quality", default="balanced", help="presets, comma-separated")
     ap.add_argument("--truth-sizes", default="2048", help="widths also rendered with Cycles, so scored")
+    ap.add_argument("--working-widths", default="", help="working widths, comma-separated (default: the preset's)")
     ap.add_argument("--engine", action="store_true", help="the engine alone instead of the command line")
     ap.add_argument("--markdown", action="store_true", help="print the table as markdown")
     ap.add_argument("--setup", type=Path, help=argparse.SUPPRESS)
     ap.add_argument("--blend", type=Path, help=argparse.SUPPRESS)
+    ap.add_argument("--working-width", type=int, help=argparse.SUPPRESS)
     ap.add_argument("--factor", type=int, default=1, help=argparse.SUPPRESS)
     ap.add_argument("--split", type=int, default=1, help=argparse.SUPPRESS)
     ap.add_argument("--engine-child", type=Path, help=argparse.SUPPRESS)
@@ -272,11 +286,12 @@ def main() -> None:
           f"seconds: process wall time; peak memory: its maximum resident set")
     rows = []
     with tempfile.TemporaryDirectory() as folder:
-        for quality in args.quality.split(","):
-            base = _run(cases[0], name, quality, args.engine, Path(folder))
+        widths = _ints(args.working_widths) or [None]
+        for preset in [(quality, w) for quality in args.quality.split(",") for w in widths]:
+            base = _run(cases[0], name, preset, args.engine, Path(folder))
             for case in cases:
-                run = base if case is cases[0] else _run(case, name, quality, args.engine, Path(folder))
-                rows.append(_cells(quality, args.engine, case, run, base))
+                run = base if case is cases[0] else _run(case, name, preset, args.engine, Path(folder))
+                rows.append(_cells(preset, args.engine, case, run, base))
                 print(" | ".join(rows[-1]), file=sys.stderr, flush=True)
     _print_table(rows, args.markdown)
 

@@ -15,7 +15,7 @@ from bpy.props import (
 from mathutils import Matrix
 
 # Standard library and the error type only: reading it keeps registering the add-on cheap.
-from ..addon.quality import DEFAULT_QUALITY, DESCRIPTIONS, Params
+from ..addon.quality import DEFAULT_QUALITY, DESCRIPTIONS, MIN_WORKING_WIDTH, Params
 
 QUALITY_ITEMS = tuple((name, name.title(), description) for name, description in DESCRIPTIONS.items())
 
@@ -23,7 +23,7 @@ QUALITY_ITEMS = tuple((name, name.title(), description) for name, description in
 _DEFAULTS = Params()
 
 # Settings that override the preset's engine parameter of the same name (addon.quality.Params).
-OVERRIDABLE = ("patches", "max_senders", "max_bounces", "raster_cell", "synth_neighbourhood",
+OVERRIDABLE = ("patches", "max_senders", "max_bounces", "working_width", "raster_cell", "synth_neighbourhood",
                "synth_generations", "seed", "insertion_passes")
 
 
@@ -193,6 +193,12 @@ class DimredSettings(bpy.types.PropertyGroup):
         name="Bounces", min=0, soft_max=32, default=_DEFAULTS.max_bounces,
         description="How many times the change of light is passed around the room: more remove the "
                     "object's colour bleeding further away, each costs a transport step",
+    )
+    working_width: IntProperty(
+        name="Solve Width", min=MIN_WORKING_WIDTH, soft_max=4096, step=2, default=_DEFAULTS.working_width,
+        description="The light is solved on a copy of the panorama at most this many pixels wide (even); the "
+                    "full-size panorama takes it from there and is filled at its own size. Wider resolves finer "
+                    "shadows and needs more time and memory",
     )
     raster_cell: FloatProperty(
         name="Fill Cell", min=0.2, soft_max=3.0, default=_DEFAULTS.raster_cell,

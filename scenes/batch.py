@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+from collections.abc import Sequence
 from pathlib import Path
 
 from . import spec as S
@@ -15,14 +16,15 @@ SCENES = ["basic_box", "red_box", "stool", "wall_contact", "bright_lamp", "seam"
 DRAFT = {"quality": "draft"}
 
 
-def batch_jobs(folder: Path) -> list[dict]:
-    """The 20 jobs, over the cached renders of SCENES (rendered here when missing)."""
+def batch_jobs(folder: Path, *, removals: Sequence[str] = SCENES) -> list[dict]:
+    """The jobs, over the cached renders of SCENES (rendered here when missing): a draft removal
+    of each of `removals` (all of SCENES: the 20 jobs), then the 12 others."""
     blends = {name: str(render_pair(S.get(name))["blend"]) for name in SCENES}
     removed = {name: S.get(name).remove for name in SCENES}
     damaged = folder / "damaged.blend"
     damaged.write_bytes(b"BLENDER-v402" + bytes(range(256)) * 4)  # a header, then nothing Blender can read
     jobs = [{"id": f"{name}-remove", "blend": blends[name], "op": "remove", "object": removed[name],
-             "params": DRAFT} for name in SCENES]
+             "params": DRAFT} for name in removals]
     jobs += [
         {"id": "basic_box-balanced", "blend": blends["basic_box"], "op": "remove", "object": "Box"},
         {"id": "second_object-both", "blend": blends["second_object"], "op": "remove", "objects": ["Box", "Cabinet"],
@@ -43,7 +45,6 @@ def batch_jobs(folder: Path) -> list[dict]:
         {"id": "damaged", "blend": str(damaged), "op": "remove", "object": "Box"},
         {"id": "unknown-object", "blend": blends["basic_box"], "op": "remove", "object": "Sofa"},
     ]
-    assert len(jobs) == 20
     return jobs
 
 
@@ -69,9 +70,9 @@ def single(job: dict, out: Path) -> subprocess.CompletedProcess:
     return cli(*arguments, "--out", str(out))
 
 
-def write_jobs_file(folder: Path) -> tuple[Path, list[dict]]:
-    """folder/jobs.jsonl holding `batch_jobs(folder)`, and the jobs."""
-    jobs = batch_jobs(folder)
+def write_jobs_file(folder: Path, *, removals: Sequence[str] = SCENES) -> tuple[Path, list[dict]]:
+    """folder/jobs.jsonl holding `batch_jobs(folder, removals=removals)`, and the jobs."""
+    jobs = batch_jobs(folder, removals=removals)
     path = folder / "jobs.jsonl"
     path.write_text("".join(json.dumps(j) + "\n" for j in jobs), encoding="utf-8")
     return path, jobs

@@ -192,12 +192,17 @@ class CaseResult:
 
 
 def run_case(pair: dict[str, Path], object_name: str, error: ProxyError, work: str | Path, *,
-             quality: str = "balanced", cli_args: Sequence[str] = (), timeout: float | None = 900.0) -> CaseResult:
+             quality: str = "balanced", cli_args: Sequence[str] = (), timeout: float | None = 900.0,
+             proxy: PerturbedBlend | None = None) -> CaseResult:
     """Remove `object_name` through `python -m addon.cli remove` from the pair's scene with the
-    proxy off by `error` (written into `work`, as is the command's output) and score it."""
+    proxy off by `error` (written into `work`, as is the command's output, unless `proxy` is
+    that scene already written) and score it."""
     work = Path(work)
     work.mkdir(parents=True, exist_ok=True)
-    proxy = perturbed_blend(pair["blend"], object_name, error, work / "scene.blend")
+    if proxy is None:
+        proxy = perturbed_blend(pair["blend"], object_name, error, work / "scene.blend")
+    elif proxy.error != error:
+        raise ValueError(f"the proxy given is off by {proxy.error}, not by {error}")
     out = work / "out"
     command = [sys.executable, "-m", "addon.cli", "remove", str(proxy.path), "--object", object_name,
                "--out", str(out), "--quality", quality, *cli_args]

@@ -151,7 +151,8 @@ def _task(job: Job, inspection: Inspection, out: str, digests: dict[str, str], s
     inputs = {path: _digest(path, digests) for path in dict.fromkeys(files)}
     fingerprint = job_fingerprint(job, inputs, version=addon_version())
     width, height = inspection.size
-    need = memory.required_bytes(width, height, quality=params.get("quality", DEFAULT_QUALITY))
+    need = memory.required_bytes(width, height, quality=params.get("quality", DEFAULT_QUALITY),
+                                 working_width=params.get("working_width"))
     return Task(job=job, out=out, fingerprint=fingerprint, inputs=inputs, launcher=settings.launcher,
                 timeout=settings.timeout), need
 

@@ -25,7 +25,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from ..errors import DimredError
-from ..quality import DESCRIPTIONS
+from ..quality import DESCRIPTIONS, MIN_WORKING_WIDTH
 
 OPERATIONS = ("remove", "relocate", "align")
 _ALL = frozenset(OPERATIONS)
@@ -57,6 +57,13 @@ def _number(value: object, _folder: str) -> float:
     if not math.isfinite(number):
         raise ValueError("must be a finite number")
     return number
+
+
+def _working_width(value: object, folder: str) -> int:
+    number = _number(value, folder)
+    if number != int(number) or number < MIN_WORKING_WIDTH or number % 2:
+        raise ValueError(f"must be an even number of pixels, at least {MIN_WORKING_WIDTH}")
+    return int(number)
 
 
 def _flag(value: object, _folder: str) -> bool:
@@ -93,6 +100,7 @@ def _existing_file(value: object, folder: str) -> str:
 
 PARAMS: dict[str, _Param] = {
     "quality": _Param(_ALL, "--quality", _quality),
+    "working_width": _Param(_MOVING, "--working-width", _working_width),
     "plane": _Param(_ALL, "--plane", _names),
     "center": _Param(_ALL, "--center", _vector),
     "fit_height": _Param(_ALL, "--fit-height", _flag),

@@ -31,7 +31,7 @@ import numpy as np
 from .. import memory
 from ..callbacks import RunCallbacks
 from ..errors import DimredError
-from ..quality import DEFAULT_QUALITY, DESCRIPTIONS
+from ..quality import DEFAULT_QUALITY, DESCRIPTIONS, MIN_WORKING_WIDTH, PRESETS
 from . import batch_cli
 
 if TYPE_CHECKING:
@@ -60,6 +60,12 @@ synthesised from the surface around it. Writes into the output folder:
 Files are written only when the whole run succeeds."""
 
 _QUALITY_HELP = f"accuracy preset (default: {DEFAULT_QUALITY}; see the presets below)"
+
+_WORKING_WIDTH_HELP = (
+    f"solve the light on a copy of the panorama at most this wide (even, at least {MIN_WORKING_WIDTH}; default: "
+    + ", ".join(f"{name} {params.working_width}" for name, params in PRESETS.items())
+    + "); the full-size panorama takes the light from there and is filled at its own size: wider resolves "
+    "finer shadows for more time and memory")
 
 _PRESET_LINES = "\n".join(f"  {name:<10} {description}" for name, description in DESCRIPTIONS.items())
 
@@ -199,6 +205,8 @@ def _scene_arguments(parser: argparse.ArgumentParser, blend_already_loaded: bool
     )
     parser.add_argument("--out", required=True, metavar="DIR", help="output folder (created if needed)")
     parser.add_argument("--quality", choices=tuple(DESCRIPTIONS), default=DEFAULT_QUALITY, help=_QUALITY_HELP)
+    if removal:
+        parser.add_argument("--working-width", type=_working_width, metavar="PX", help=_WORKING_WIDTH_HELP)
     parser.add_argument(
         "--center",
         nargs=3,
@@ -207,6 +215,22 @@ def _scene_arguments(parser: argparse.ArgumentParser, blend_already_loaded: bool
         help="probe centre in world space, overriding the scene's",
     )
     parser.add_argument("--verbose", action="store_true", help="print progress and notes on stderr")
+
+
+def _working_width(text: str) -> int:
+    try:
+        width = int(text)
+    except ValueError:
+        width = None
+    if width is None or width < MIN_WORKING_WIDTH or width % 2:
+        raise argparse.ArgumentTypeError(
+            f"must be an even number of pixels, at least {MIN_WORKING_WIDTH}, not {text!r}")
+    return width
+
+
+def _overrides(args: argparse.Namespace) -> dict[str, int]:
+    """The preset's parameters the command line sets."""
+    return {} if getattr(args, "working_width", None) is None else {"working_width": args.working_width}
 
 
 def _remove(args: argparse.Namespace) -> int:
@@ -326,6 +350,7 @@ def _run(args: argparse.Namespace, done: str, compute: Callable[..., object]) ->
         quality=args.quality,
         mask=mask,
         callbacks=RunCallbacks(progress=_print_progress if args.verbose else None),
+        **_overrides(args),
     )
     report = dict(result.report)
     seconds = dict(report.get("seconds", {}))
@@ -371,7 +396,7 @@ def _read(args: argparse.Namespace) -> SceneData:
         reader.check_object(scene, plane, purpose="used as a --plane")
     # Before the pixels are read: a run that cannot fit is refused now, not killed halfway.
     width, height = reader.panorama_size(scene)
-    memory.check_fits(width, height, quality=args.quality)
+    memory.check_fits(width, height, quality=args.quality, **_overrides(args))
     scene_data = reader.read_scene(scene, center=args.center)
     if args.verbose:
         for note in scene_data.notes:

@@ -212,7 +212,8 @@ class RemovalSession:
             reader.check_object(scene, target)
             # Refused before any work when the panorama cannot fit (the size from its header).
             size = reader.panorama_size(scene)
-            memory.check_fits(*size, quality=settings.quality)
+            memory.check_fits(*size, quality=settings.quality,
+                              working_width=settings.overrides().get("working_width"))
             mask = None if settings.mask_image is None else mask_of_image(settings.mask_image, size)
             names = settings.surface_names()
             for name in names:

@@ -74,11 +74,11 @@ class FakeEngine:
         self.calls: list[dict] = []
 
     def __call__(self, scene_data, object_name, *, planes=(), quality="balanced", callbacks=NO_CALLBACKS, mask=None,
-                 align=False, fit_height=False):
+                 align=False, fit_height=False, **overrides):
         progress = callbacks.progress
         self.calls.append(
             {"scene": scene_data, "object": object_name, "planes": planes, "quality": quality, "progress": progress,
-             "mask": mask, "align": align, "fit_height": fit_height}
+             "mask": mask, "align": align, "fit_height": fit_height, "overrides": overrides}
         )
         if progress is not None:
             progress("synthesis", 0.5)
@@ -131,6 +131,7 @@ def test_success_writes_the_three_files(room, engine, monkeypatch, tmp_path, cap
     assert _lines(stderr) == ["dimred: warning: 3 pixels clamped"]
     call = engine.calls[0]
     assert (call["object"], call["planes"], call["quality"], call["progress"]) == ("Box", ["Floor"], "draft", None)
+    assert call["overrides"] == {}
     np.testing.assert_array_equal(call["scene"].hdri, HDRI)
     assert call["scene"].object_names == ["Box", "Floor"]
 
@@ -293,6 +294,15 @@ def test_a_panorama_too_big_for_the_free_memory_is_refused_before_it_is_read(roo
     assert room.read_bytes() == blend
 
 
+def test_the_working_width_reaches_the_engine_and_the_memory_check(room, engine, monkeypatch, tmp_path):
+    checked = []
+    monkeypatch.setattr(memory, "check_fits", lambda *size, **options: checked.append((size, options)))
+    out = tmp_path / "result"
+    assert cli.main(["remove", str(room), "--object", "Box", "--out", str(out), "--working-width", "512"]) == 0
+    assert engine.calls[0]["overrides"] == {"working_width": 512}
+    assert checked == [((16, 8), {"quality": "balanced", "working_width": 512})]
+
+
 def test_out_is_a_file(room, engine, tmp_path, capfd):
     out = tmp_path / "taken"
     out.write_text("mine")
@@ -304,7 +314,9 @@ def test_out_is_a_file(room, engine, tmp_path, capfd):
 @pytest.mark.parametrize(
     "arguments",
     [[], ["remove"], ["remove", "x.blend", "--out", "o"],
-     ["remove", "x.blend", "--object", "Box", "--out", "o", "--quality", "best"]],
+     ["remove", "x.blend", "--object", "Box", "--out", "o", "--quality", "best"],
+     *(["remove", "x.blend", "--object", "Box", "--out", "o", "--working-width", w] for w in ("1023", "64", "wide")),
+     ["align", "x.blend", "--object", "Box", "--out", "o", "--working-width", "512"]],
 )
 def test_usage_errors_exit_2(arguments, engine, capfd):
     assert cli.main(arguments) == 2
@@ -370,8 +382,10 @@ def test_relocate_passes_the_move_and_writes_the_three_files(room, relocation, t
 def test_relocate_through_the_blender_command(room, relocation, tmp_path):
     bpy.ops.wm.open_mainfile(filepath=str(room), load_ui=False)
     out = tmp_path / "from-blender"
-    assert cli.blender_command(["relocate", "--object", "Box", "--yaw", "15", "--out", str(out)]) == 0
+    assert cli.blender_command(["relocate", "--object", "Box", "--yaw", "15", "--out", str(out),
+                                "--working-width", "2048"]) == 0
     assert relocation.calls[0]["move"] == Move(15.0, 1.0)
+    assert relocation.calls[0]["overrides"] == {"working_width": 2048}
 
 
 @pytest.mark.parametrize("scale, expected", [("0", "positive number, got 0.0"), ("-1.3", "got -1.3"),

@@ -297,4 +297,13 @@ def test_parameter_overrides_reach_the_engine(room, extension):
     settings.patches, settings.seed = 123, 7
     assert bpy.ops.dimred.remove() == {'FINISHED'}
     used = json.loads(settings.last_report)["parameters"]
-    assert used["patches"] == 123 and used["seed"] == 7
+    assert used["patches"] == 123 and used["seed"] == 7 and used["working_width"] == PRESETS["balanced"].working_width
+    settings.working_width = 512
+    assert bpy.ops.dimred.remove() == {'FINISHED'}
+    assert json.loads(settings.last_report)["parameters"]["working_width"] == 512
+    # An odd width is refused with what to type, and the last result stays.
+    last = settings.last_report
+    settings.working_width = 1023
+    with pytest.raises(RuntimeError, match="working_width must be an even number of pixels, at least 128, not 1023"):
+        bpy.ops.dimred.remove()
+    assert settings.last_report == last

@@ -31,6 +31,21 @@ def test_required_bytes_grow_with_the_pixels_over_the_solve():
         memory.required_bytes(8, 4, quality="best")
 
 
+def test_a_wider_working_copy_than_the_presets_adds_its_pixels():
+    balanced = memory.required_bytes(8192, 4096, quality="balanced")
+    assert memory.required_bytes(8192, 4096, quality="balanced", working_width=1024) == balanced
+    wider = memory.required_bytes(8192, 4096, quality="balanced", working_width=2048)
+    assert wider - balanced == memory.WORKING_BYTES_PER_PIXEL * (2048 * 1024 - 1024 * 512) > 0
+    # A narrower one saves what its solve saves, which the estimate does not count on.
+    assert memory.required_bytes(8192, 4096, quality="final", working_width=512) == memory.required_bytes(
+        8192, 4096, quality="final")
+    # A panorama narrower than the working width is solved at its own size.
+    assert memory.required_bytes(1536, 768, quality="balanced", working_width=4096) - memory.required_bytes(
+        1536, 768, quality="balanced") == memory.WORKING_BYTES_PER_PIXEL * (1536 * 768 - 1024 * 512)
+    assert memory.required_bytes(800, 400, quality="balanced", working_width=4096) == memory.required_bytes(
+        800, 400, quality="balanced")
+
+
 def test_a_run_that_does_not_fit_is_refused_with_what_to_do():
     needed = memory.required_bytes(16384, 8192, quality="balanced")
     with pytest.raises(DimredError) as refused:
@@ -42,6 +57,8 @@ def test_a_run_that_does_not_fit_is_refused_with_what_to_do():
     memory.check_fits(16384, 8192, quality="balanced", available=needed)
     with pytest.raises(DimredError):
         memory.check_fits(16384, 8192, quality="balanced", available=needed - 1)
+    with pytest.raises(DimredError, match=r"use a smaller copy of the panorama or a narrower working width$"):
+        memory.check_fits(16384, 8192, quality="balanced", working_width=4096, available=needed)
 
 
 def test_the_machine_is_asked_when_no_figure_is_given(monkeypatch):

@@ -19,7 +19,16 @@ import numpy as np
 import pytest
 
 from scenes import spec as S
-from scenes.perturb import CaseResult, ProxyError, error_matrix, parse, perturbed_blend, pose_error, run_case
+from scenes.perturb import (
+    CaseResult,
+    PerturbedBlend,
+    ProxyError,
+    error_matrix,
+    parse,
+    perturbed_blend,
+    pose_error,
+    run_case,
+)
 from scenes.render import REPO, render_pair
 
 SCENES = ["basic_box", "red_box"]
@@ -39,8 +48,11 @@ def _far_bound(exact: CaseResult) -> float:
 TOTAL_MARGIN = 0.10
 ALIGNED_CASES = ["shift 5 cm at 45 deg", "turn 5 deg", "scale 0.95", "scale 1.05"]
 # A beige crate against a beige wall: the segmented outline is partly the proxy's, and alignment
-# recovers part of the error only (a known limit); it must not make the removal worse.
-HARD = ("wall_contact", ["shift 5 cm at 45 deg", "scale 0.95"])
+# recovers part of the error only (a known limit); it must not make the removal worse. With the
+# crate 5 % too small it does (0.36 against 0.33 unaligned at 512x256: the fit passes its gain
+# test and leaves 4.5 % of scale), a known limit that `benchmarks/bench_rough_proxies.py
+# --cli-args=--align` measures; it left the suite to keep it within CI's 15 minutes.
+HARD = ("wall_contact", "shift 5 cm at 45 deg")
 ALIGNED_MARGIN = 0.05
 GHOST_MARGIN = 0.02
 
@@ -131,6 +143,20 @@ def exact_run(tmp_path_factory):
     return run
 
 
+@pytest.fixture(scope="module")
+def proxy(tmp_path_factory, exact_run):
+    """(scene name, case label) -> the scene's .blend with the proxy off by the case, written
+    once per module: the cases with and without --align share it."""
+
+    @cache
+    def written(name: str, label: str) -> PerturbedBlend:
+        spec, pair, _ = exact_run(name)
+        folder = tmp_path_factory.mktemp(f"{name}_proxy")
+        return perturbed_blend(pair["blend"], spec.remove, parse(label), folder / "scene.blend")
+
+    return written
+
+
 @pytest.mark.slow
 def test_perturbed_blend_moves_the_proxy_by_the_error(tmp_path) -> None:
     spec = S.get(SCENES[0]).with_render(**RENDER)
@@ -168,9 +194,9 @@ def test_removal_with_the_exact_proxy(name, exact_run) -> None:
 @pytest.mark.slow
 @pytest.mark.parametrize("label", CASES)
 @pytest.mark.parametrize("name", SCENES)
-def test_removal_with_a_rough_proxy_stays_near_the_exact_one(name, label, exact_run, tmp_path) -> None:
+def test_removal_with_a_rough_proxy_stays_near_the_exact_one(name, label, exact_run, proxy, tmp_path) -> None:
     spec, pair, exact = exact_run(name)
-    rough = run_case(pair, spec.remove, parse(label), tmp_path)
+    rough = run_case(pair, spec.remove, parse(label), tmp_path, proxy=proxy(name, label))
     print(f"{name} {label}: total {rough.total:.3f} (exact {exact.total:.3f}), lighting {rough.lighting:.3f} "
           f"(exact {exact.lighting:.3f}), ghost {rough.ghost:.3f} (exact {exact.ghost:.3f}), far {rough.far:.3f}, "
           f"{rough.nans} NaN, {rough.seconds:.1f} s")
@@ -183,9 +209,10 @@ def test_removal_with_a_rough_proxy_stays_near_the_exact_one(name, label, exact_
 @pytest.mark.slow
 @pytest.mark.parametrize("label", ALIGNED_CASES)
 @pytest.mark.parametrize("name", SCENES)
-def test_removal_after_align_to_photo_stays_as_good_as_the_exact_proxy(name, label, exact_run, tmp_path) -> None:
+def test_removal_after_align_to_photo_stays_as_good_as_the_exact_proxy(name, label, exact_run, proxy,
+                                                                       tmp_path) -> None:
     spec, pair, exact = exact_run(name)
-    rough = run_case(pair, spec.remove, parse(label), tmp_path, cli_args=["--align"])
+    rough = run_case(pair, spec.remove, parse(label), tmp_path, cli_args=["--align"], proxy=proxy(name, label))
     print(f"{name} {label} --align: total {rough.total:.3f} (exact {exact.total:.3f}), ghost {rough.ghost:.3f} "
           f"(exact {exact.ghost:.3f}), far {rough.far:.3f}, pose left {rough.pose}, {rough.seconds:.1f} s")
     assert rough.failure is None, rough.failure
@@ -196,18 +223,13 @@ def test_removal_after_align_to_photo_stays_as_good_as_the_exact_proxy(name, lab
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("label", [
-    HARD[1][0],
-    # Known limit: at 512x256 the fit still passes its gain test here and leaves 4.5 % of scale,
-    # 0.36 against 0.33 unaligned (at 1024x512 the proxy is left as modelled instead).
-    pytest.param(HARD[1][1], marks=pytest.mark.xfail(strict=True,
-                                                      reason="alignment misled by a crate of the wall's colour")),
-])
-def test_align_to_photo_makes_a_hard_case_no_worse(label, exact_run, tmp_path) -> None:
-    spec, pair, exact = exact_run(HARD[0])
-    plain = run_case(pair, spec.remove, parse(label), tmp_path / "plain")
-    aligned = run_case(pair, spec.remove, parse(label), tmp_path / "aligned", cli_args=["--align"])
-    print(f"{HARD[0]} {label}: total {plain.total:.3f} without, {aligned.total:.3f} with --align "
+def test_align_to_photo_makes_a_hard_case_no_worse(exact_run, proxy, tmp_path) -> None:
+    name, label = HARD
+    spec, pair, exact = exact_run(name)
+    plain = run_case(pair, spec.remove, parse(label), tmp_path / "plain", proxy=proxy(name, label))
+    aligned = run_case(pair, spec.remove, parse(label), tmp_path / "aligned", cli_args=["--align"],
+                       proxy=proxy(name, label))
+    print(f"{name} {label}: total {plain.total:.3f} without, {aligned.total:.3f} with --align "
           f"(exact {exact.total:.3f}), pose left {aligned.pose}")
     assert plain.failure is None and aligned.failure is None
     assert aligned.nans == 0 and aligned.far <= _far_bound(exact)

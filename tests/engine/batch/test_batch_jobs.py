@@ -60,16 +60,20 @@ def test_every_bad_line_is_reported_with_its_number(tmp_path, scenes):
         {"blend": blend, "op": "remove", "object": "Chair", "id": "same"},
         {"blend": blend, "op": "relocate", "object": "Box", "params": {"yaw": "NaN"}},
         "[1, 2]",
+        {"blend": blend, "op": "remove", "object": "Box", "params": {"working_width": 1000.5}},
+        {"blend": blend, "op": "align", "object": "Box", "params": {"working_width": 2048}},
     ])
     with pytest.raises(JobsFileError) as caught:
         read_jobs(str(path))
     problems = caught.value.problems
-    assert [int(p.split()[1].rstrip(":")) for p in problems] == [*range(2, 13), 14, 15, 16]
+    assert [int(p.split()[1].rstrip(":")) for p in problems] == [*range(2, 13), 14, 15, 16, 17, 18]
     expected = ["'op' must be one of", "'op' must be one of remove, relocate, align, not 'explode'",
                 "no such .blend file", "not valid JSON", "missing field 'object'", "'relocate' takes one object",
                 "parameter 'yaw' does not apply to 'remove'", "parameter 'quality' must be one of",
                 "parameter 'mask' no such file", "unknown parameter 'colour'", "'id' must be",
-                "id 'same' is already the id of line 13", "must be a finite number", "must be a JSON object"]
+                "id 'same' is already the id of line 13", "must be a finite number", "must be a JSON object",
+                "parameter 'working_width' must be an even number of pixels, at least 128",
+                "parameter 'working_width' does not apply to 'align'"]
     for problem, words in zip(problems, expected, strict=True):
         assert words in problem, problem
 
@@ -98,8 +102,8 @@ def test_paths_and_names_are_data_never_expanded_or_evaluated(tmp_path, scenes, 
                  "fit_height": True}},
      ["--align", "--center", "0.0", "0.5", "1.6", "--fit-height", "--plane", "Floor", "--plane", "Rug",
       "--quality", "draft"]),
-    ({"op": "relocate", "params": {"yaw": -40, "distance_scale": 1.25}},
-     ["--distance-scale", "1.25", "--yaw", "-40.0"]),
+    ({"op": "relocate", "params": {"yaw": -40, "distance_scale": 1.25, "working_width": "2048"}},
+     ["--distance-scale", "1.25", "--working-width", "2048", "--yaw", "-40.0"]),
     ({"op": "align", "params": {"save": True}}, ["--save", "/out/aligned.blend"]),
     ({"op": "align", "params": {"save": False}}, []),
 ])
@@ -113,6 +117,7 @@ def test_the_arguments_are_what_the_command_line_takes(tmp_path, scenes, fields,
     params = job.parameters()
     if "yaw" in params:
         assert (parsed.yaw, parsed.distance_scale) == (params["yaw"], params["distance_scale"])
+        assert parsed.working_width == params["working_width"] == 2048
     if "plane" in params:
         assert parsed.plane == params["plane"] and parsed.center == params["center"]
 
