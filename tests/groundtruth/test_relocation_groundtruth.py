@@ -7,7 +7,7 @@ the lighting each placement changes against the render without the object): the 
 edit over that of the unedited input, at most 40 % (the edit must remove most of what the move
 changes, though the moved object's appearance is carried from one view only), with every pixel finite
 and nothing damaged far from both places. The scenes differ in room, lamps, object kind and
-colour, the move's direction and size, and the world's rotation.
+colour, and the move's direction and size.
 """
 from __future__ import annotations
 
@@ -26,10 +26,12 @@ from scenes.render import REPO, load_pair, render_pair
 
 BOUND = 0.4
 FAR_DAMAGE = 0.08
-# red_box, moved by 25 degrees and 0.8 of its distance, is checked with its colour below.
-CASES = [("basic_box", 40.0, 1.3), ("stool", 40.0, 1.3), ("rotated_world", -40.0, 1.3),
-         ("wall_contact", -40.0, 1.3), ("second_object", -40.0, 1.3),
-         ("bright_lamp", 40.0, 1.3), ("seam", 40.0, 1.3), ("nadir", 40.0, 1.3)]
+# red_box, moved by 25 degrees and 0.8 of its distance, is checked with its colour below. A move
+# in a turned world (the rotated_world scene) or across the panorama's seam (seam) is the same
+# move as in basic_box, turned: `tests/engine/relocation/test_relocation.py` holds the engine to
+# that to rounding, so their renders (in the suite until the 15 minutes of CI ran out) left it.
+CASES = [("basic_box", 40.0, 1.3), ("stool", 40.0, 1.3), ("wall_contact", -40.0, 1.3), ("second_object", -40.0, 1.3),
+         ("bright_lamp", 40.0, 1.3), ("nadir", 40.0, 1.3)]
 
 
 def _relocate(tmp_path, blend, name: str, *arguments: str) -> subprocess.CompletedProcess:
