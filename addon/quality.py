@@ -95,11 +95,18 @@ def params_for(quality: str, **overrides) -> Params:
         params = replace(PRESETS[quality], **overrides)
     except TypeError as exc:
         raise DimredError(f"unknown parameter: {exc}") from None
-    width = params.working_width
-    if isinstance(width, bool) or not isinstance(width, int) or width < MIN_WORKING_WIDTH or width % 2:
-        raise DimredError(f"working_width must be an even number of pixels, at least {MIN_WORKING_WIDTH}, "
-                          f"not {width!r}")
+    problem = working_width_problem(params.working_width)
+    if problem:
+        raise DimredError(f"working_width {problem}, not {params.working_width!r}")
     return params
+
+
+def working_width_problem(width: object) -> str | None:
+    """What is wrong with `width` as a working width (the command line, the batch's jobs and the
+    parameters say it alike), else None."""
+    if isinstance(width, bool) or not isinstance(width, int) or width < MIN_WORKING_WIDTH or width % 2:
+        return f"must be an even number of pixels, at least {MIN_WORKING_WIDTH}"
+    return None
 
 
 # The solver's accuracy knobs (not the synthesis's, not the relocation's passes).

@@ -25,7 +25,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from ..errors import DimredError
-from ..quality import DESCRIPTIONS, MIN_WORKING_WIDTH
+from ..quality import DESCRIPTIONS, working_width_problem
 
 OPERATIONS = ("remove", "relocate", "align")
 _ALL = frozenset(OPERATIONS)
@@ -61,9 +61,11 @@ def _number(value: object, _folder: str) -> float:
 
 def _working_width(value: object, folder: str) -> int:
     number = _number(value, folder)
-    if number != int(number) or number < MIN_WORKING_WIDTH or number % 2:
-        raise ValueError(f"must be an even number of pixels, at least {MIN_WORKING_WIDTH}")
-    return int(number)
+    width = int(number) if number == int(number) else number
+    problem = working_width_problem(width)
+    if problem:
+        raise ValueError(problem)
+    return width
 
 
 def _flag(value: object, _folder: str) -> bool:

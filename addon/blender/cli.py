@@ -31,7 +31,7 @@ import numpy as np
 from .. import memory
 from ..callbacks import RunCallbacks
 from ..errors import DimredError
-from ..quality import DEFAULT_QUALITY, DESCRIPTIONS, MIN_WORKING_WIDTH, PRESETS
+from ..quality import DEFAULT_QUALITY, DESCRIPTIONS, MIN_WORKING_WIDTH, PRESETS, working_width_problem
 from . import batch_cli
 
 if TYPE_CHECKING:
@@ -222,9 +222,9 @@ def _working_width(text: str) -> int:
         width = int(text)
     except ValueError:
         width = None
-    if width is None or width < MIN_WORKING_WIDTH or width % 2:
-        raise argparse.ArgumentTypeError(
-            f"must be an even number of pixels, at least {MIN_WORKING_WIDTH}, not {text!r}")
+    problem = working_width_problem(width)
+    if problem:
+        raise argparse.ArgumentTypeError(f"{problem}, not {text!r}")
     return width
 
 
