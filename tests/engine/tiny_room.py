@@ -12,6 +12,7 @@ interpreter whose engine must come from the installed extension, not from this c
 """
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -139,6 +140,15 @@ def _triangulate(vertices: list, polygons: list) -> np.ndarray:
     positions = np.asarray(vertices, dtype=np.float32).astype(np.float64)
     corners = [(p[0], p[i], p[i + 1]) for p in polygons for i in range(1, len(p) - 1)]
     return positions[np.array(corners)]
+
+
+def turned(scene: SceneData, columns: int) -> SceneData:
+    """`scene` photographed turned by `columns` pixels about the vertical: its panorama rolled
+    by as many columns and the world's texture rotation turned back by as much, so the same room
+    and the same photograph of it, the seam elsewhere."""
+    a = -2.0 * np.pi * columns / scene.hdri.shape[1]
+    turn = np.array([[np.cos(a), -np.sin(a), 0.0], [np.sin(a), np.cos(a), 0.0], [0.0, 0.0, 1.0]])
+    return replace(scene, rotation=turn @ scene.rotation, hdri=np.roll(scene.hdri, columns, axis=1))
 
 
 def scene_data(width: int, height: int) -> SceneData:

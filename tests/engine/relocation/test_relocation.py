@@ -22,11 +22,13 @@ def tiny():
     return tiny_room.scene_data(128, 64)
 
 
-def _box_pixels(scene, lo, hi) -> np.ndarray:
-    """(H, W) pixels whose ray from the probe enters the box lo..hi."""
+def _box_pixels(scene, lo, hi, matrix: np.ndarray | None = None) -> np.ndarray:
+    """(H, W) pixels whose ray from the probe enters the box lo..hi, moved by the 4x4 `matrix`
+    if given."""
     h, w = scene.hdri.shape[:2]
-    d = latlong.pixel_directions(w, h)
-    return np.isfinite(tiny_room._ray_box(np.asarray(scene.center), d, lo, hi))
+    inverse = np.eye(4) if matrix is None else np.linalg.inv(matrix)
+    d = latlong.pixel_directions(w, h) @ inverse[:3, :3].T
+    return np.isfinite(tiny_room._ray_box(inverse[:3, :3] @ scene.center + inverse[:3, 3], d, lo, hi))
 
 
 def test_moving_nowhere_gives_back_the_photograph(tiny):
@@ -189,21 +191,10 @@ def unturned(tiny):
     return relocate_object(tiny, "Box", MOVE, quality="draft")
 
 
-def _turned(scene, columns: int):
-    """`scene` with its panorama turned by `columns` pixels about the vertical and the world's
-    texture rotation turned back by as much: the same room, the same photograph of it."""
-    a = -2.0 * np.pi * columns / scene.hdri.shape[1]
-    rotation = np.array([[np.cos(a), -np.sin(a), 0.0], [np.sin(a), np.cos(a), 0.0], [0.0, 0.0, 1.0]])
-    return replace(scene, hdri=np.roll(scene.hdri, columns, axis=1), rotation=rotation)
-
-
 def _placed_columns(scene, matrix: np.ndarray, columns: int) -> np.ndarray:
     """The panorama columns the box moved by `matrix` covers, turned by `columns`."""
-    h, w = scene.hdri.shape[:2]
-    inverse = np.linalg.inv(matrix)
-    d = latlong.pixel_directions(w, h) @ inverse[:3, :3].T
-    hit = np.isfinite(tiny_room._ray_box(inverse[:3, :3] @ scene.center + inverse[:3, 3], d, *tiny_room.BOX))
-    return np.unique((np.nonzero(hit.any(axis=0))[0] + columns) % w)
+    hit = _box_pixels(scene, *tiny_room.BOX, matrix)
+    return np.unique((np.nonzero(hit.any(axis=0))[0] + columns) % hit.shape[1])
 
 
 @pytest.mark.parametrize("columns, across_the_seam", [(32, None), (64, "old place"), (50, "new place")])
@@ -211,7 +202,7 @@ def test_a_move_in_a_turned_world_and_across_the_seam_is_the_same_move(tiny, unt
     """The world's texture rotation and the panorama's seam are conventions of the photograph,
     not of the room: the room photographed turned by whole pixel columns gives the same move's
     difference image, turned by as much (the fill up to its synthesis's choices)."""
-    turned = relocate_object(_turned(tiny, columns), "Box", MOVE, quality="draft")
+    turned = relocate_object(tiny_room.turned(tiny, columns), "Box", MOVE, quality="draft")
     w = tiny.hdri.shape[1]
     at = {"old place": np.eye(4), "new place": np.array(unturned.report["relocation"]["matrix"])}
     if across_the_seam is not None:

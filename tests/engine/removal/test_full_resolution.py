@@ -2,8 +2,6 @@
 light is upsampled and refined, the hidden region traced and filled at the panorama's size."""
 from __future__ import annotations
 
-from dataclasses import replace
-
 import numpy as np
 import pytest
 import tiny_room
@@ -76,10 +74,7 @@ def test_an_object_across_the_seam(runs):
     # The room turned so the box straddles u = 0: the window wraps round the seam.
     scene = runs["scene"]
     cols = np.flatnonzero(runs["direct"].hidden_mask.any(axis=0))
-    shift = W - (cols.min() + cols.max()) // 2
-    angle = -2 * np.pi * shift / W
-    turn = np.array([[np.cos(angle), -np.sin(angle), 0.0], [np.sin(angle), np.cos(angle), 0.0], [0.0, 0.0, 1.0]])
-    seam = replace(scene, rotation=turn @ scene.rotation, hdri=np.roll(scene.hdri, shift, axis=1))
+    seam = tiny_room.turned(scene, W - (cols.min() + cols.max()) // 2)
     direct = remove_object(seam, "Box", working_width=W)
     up = remove_object(seam, "Box", working_width=W // 2)
     assert direct.hidden_mask[:, 0].any() and direct.hidden_mask[:, -1].any()
