@@ -1,22 +1,28 @@
 """What a fill made from the visible floor can reach in structure on plank floors, measured on
 the truth itself (the render without the object: no lighting estimate, no reflectance, only
 what the probe sees of the floor):
-    .venv/bin/python benchmarks/bench_fill_ceiling.py [--scenes a,b] [--width 1024]
+    .venv/bin/python benchmarks/bench_fill_ceiling.py [--scenes a,b] [--width 1024] [--samples 16]
 For each of the object's pixels whose ray meets the floor, the floor is followed along the
 planks (the scenes' planks run along x), both ways in 5 mm steps, to the nearest point the probe
 sees (its pixel is not the object's). Two fills of the truth's own pixels, scored as
 `bench_fill_groundtruth` scores ours (`scenes.metrics.structure_correlation`) over those floor
 pixels:
 - copy: the truth at the nearer of the two points (a shift map's best copy, per pixel);
-- interpolation: linear between the two, each the mean over 3 cm beyond it (as `lines`).
-The last column is our removal's fill over the same pixels (balanced, exact proxies).
+- interpolation: linear between the two, each the mean over 3 cm beyond it (as `lines`);
+- the same with grain: plus the truth's pixel detail (the pixel minus its 3x3 mean) at the nearer
+  point's pixel, as our fill adds its copies' detail to the lines, scaled to a detail ratio of
+  1: what the interpolation scores once it carries grain at the photograph's level, as the
+  detail bound asks.
+Each with its detail ratio (`scenes.metrics.detail_ratio`) over those pixels, as ours.
+The last columns are our removal's fill over the same pixels (balanced, exact proxies) and a
+second render of the truth (another seed: its noise alone; `rendered.second_render_structure`).
 Renders are cached (scenes.render); the first run renders what is missing (minutes each).
 """
 from __future__ import annotations
 
 import numpy as np
 
-from rendered import ground_truths, print_table_header, scene_list_arguments
+from rendered import ground_truths, print_table_header, scene_list_arguments, second_render_structure
 from scenes.spec import SceneSpec
 
 SCENES = "demo,stool,warm_cylinder,oak_chair,walnut_crate,far_pouf"
@@ -68,13 +74,39 @@ def _end_mean(points: np.ndarray, sign: int, truth: np.ndarray) -> np.ndarray:
                     for o in offsets], axis=0)
 
 
-def _scored(values: np.ndarray, truth: np.ndarray, floor: np.ndarray, reached: np.ndarray) -> float:
-    """Structure of the truth with its `floor` pixels replaced by `values` where `reached`."""
+def _scored(values: np.ndarray, truth: np.ndarray, floor: np.ndarray, reached: np.ndarray) -> str:
+    """Structure and detail ratio of the truth with its `floor` pixels replaced by `values`
+    where `reached`, as a table's cell."""
     from scenes import metrics
 
     edit = truth.copy()
     edit[floor] = np.where(reached[:, None], values, truth[floor])
-    return metrics.structure_correlation(edit, truth, floor)
+    return f"{metrics.structure_correlation(edit, truth, floor):.3f}, {metrics.detail_ratio(edit, truth, floor):.2f}"
+
+
+def _with_grain(values: np.ndarray, grain: np.ndarray, truth: np.ndarray, floor: np.ndarray,
+                reached: np.ndarray) -> np.ndarray:
+    """`values` plus `grain` scaled to a detail ratio of 1 over the floor pixels: with the two
+    independent, the ratio squared grows by the scale squared times what the whole grain adds."""
+    from scenes import metrics
+
+    def ratio(scale: float) -> float:
+        edit = truth.copy()
+        edit[floor] = np.where(reached[:, None], values + scale * grain, truth[floor])
+        return metrics.detail_ratio(edit, truth, floor)
+
+    bare, full = ratio(0.0), ratio(1.0)
+    return values + np.sqrt(max(1.0 - bare**2, 0.0) / max(full**2 - bare**2, 1e-12)) * grain
+
+
+def _grain(points: np.ndarray, truth: np.ndarray) -> np.ndarray:
+    """(N, 3) the truth's pixel detail (the pixel minus its 3 x 3 mean) at the pixels of `points`."""
+    from addon.geometry import latlong
+    from scenes import metrics
+
+    h, w = truth.shape[:2]
+    row, col = latlong.uv_to_pixel(*latlong.direction_to_uv(points), w, h)
+    return (truth - metrics.box_blur3(truth))[row, col]
 
 
 def main() -> None:
@@ -82,10 +114,11 @@ def main() -> None:
 
     from addon.geometry import planeraster
     from addon.pipeline import remove_object
-    from scenes import metrics
 
-    print_table_header(f"{args.width}x{args.width // 2}, structure over the object's floor pixels",
-                       ["scene", "floor pixels", "median distance to seen floor m", "copy", "interpolation", "ours"])
+    print_table_header(f"{args.width}x{args.width // 2} at {args.samples} samples, structure and detail ratio over"
+                       " the object's floor pixels",
+                       ["scene", "floor pixels", "median distance to seen floor m", "copy", "interpolation",
+                        "interpolation with grain", "ours", "second render"])
     for gt in ground_truths(args):
         s, truth, mask = gt.spec, gt.truth, gt.mask
         if s.room.floor.pattern != "planks" or s.world_rotation_z:
@@ -100,11 +133,13 @@ def main() -> None:
         interpolated = (share[:, None] * _end_mean(at_after, 1, truth)
                         + (1 - share[:, None]) * _end_mean(at_before, -1, truth))
         reached = np.isfinite(np.minimum(after, before))
+        grained = _with_grain(interpolated, _grain(nearer, truth), truth, floor, reached)
         r = remove_object(gt.scene, s.remove, quality="balanced")
-        ours = metrics.structure_correlation(gt.input + r.difference, truth, floor)
+        ours = (gt.input + r.difference)[floor]
         print(f"| {s.name} | {int(floor.sum())} | {np.median(np.minimum(after, before)[reached]):.2f} "
-              f"| {_scored(copy, truth, floor, reached):.3f} | {_scored(interpolated, truth, floor, reached):.3f} "
-              f"| {ours:.3f} |", flush=True)
+              f"| {_scored(copy, truth, floor, reached)} | {_scored(interpolated, truth, floor, reached)} "
+              f"| {_scored(grained, truth, floor, reached)} | {_scored(ours, truth, floor, np.ones_like(reached))} "
+              f"| {second_render_structure(gt, floor):.3f} |", flush=True)
 
 
 if __name__ == "__main__":

@@ -1,8 +1,10 @@
 """The filled region on ground-truth scenes with tiled and planked floors, structure-aware fill
 on and off, through the engine as the command line runs it (balanced, exact proxies):
-    .venv/bin/python benchmarks/bench_fill_groundtruth.py [--scenes a,b] [--width 1024]
+    .venv/bin/python benchmarks/bench_fill_groundtruth.py [--scenes a,b] [--width 1024] [--samples 16]
 Prints a markdown table: structure (`scenes.metrics.structure_correlation` over the object's
-pixels), detail ratio, mean ratio and object + shadow error (`hidden_region_scores`), NaNs,
+pixels) and beside it the same score of a second render of the truth (another seed: the render
+noise alone, the ceiling of any fill's structure; `rendered.second_render_structure`), detail
+ratio, mean ratio and object + shadow error (`hidden_region_scores`), NaNs,
 the seconds the fill of the revealed surfaces took (`filled_surfaces` in the report), and the
 report's stages `synthesis` (that fill and its previews) and `hidden_light` (the irradiance
 after the removal at the revealed pixels).
@@ -12,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rendered import FLOOR_SCENES, ground_truths, print_table_header, scene_list_arguments
+from rendered import FLOOR_SCENES, ground_truths, print_table_header, scene_list_arguments, second_render_structure
 
 
 def main() -> None:
@@ -21,18 +23,19 @@ def main() -> None:
     from addon.pipeline import remove_object
     from scenes import metrics
 
-    print_table_header(f"{args.width}x{args.width // 2}, balanced, exact proxies",
-                       ["scene", "floor", "structure-aware", "structure", "detail", "mean", "object + shadow", "NaN",
-                        "fill s", "synthesis s", "hidden light s"])
+    print_table_header(f"{args.width}x{args.width // 2} at {args.samples} samples, balanced, exact proxies",
+                       ["scene", "floor", "structure-aware", "structure", "second render", "detail", "mean",
+                        "object + shadow", "NaN", "fill s", "synthesis s", "hidden light s"])
     for gt in ground_truths(args):
         s = gt.spec
+        ceiling = second_render_structure(gt)
         for structure in (True, False):
             r = remove_object(gt.scene, s.remove, quality="balanced", synth_structure=structure)
             edit = gt.input + r.difference
             h = metrics.hidden_region_scores(gt.input, edit, gt.truth, gt.mask)
             fill_s = sum(f["seconds"] for f in r.report["filled_surfaces"])
             print(f"| {s.name} | {s.room.floor.pattern} | {'on' if structure else 'off'} | {h['structure']:.3f} "
-                  f"| {h['detail_ratio']:.2f} | {h['mean_ratio']:.3f} | {h['object_shadow_ratio']:.3f} "
+                  f"| {ceiling:.3f} | {h['detail_ratio']:.2f} | {h['mean_ratio']:.3f} | {h['object_shadow_ratio']:.3f} "
                   f"| {int(np.isnan(edit).sum())} | {fill_s:.2f} | {r.report['seconds']['synthesis']:.2f} "
                   f"| {r.report['seconds']['hidden_light']:.2f} |", flush=True)
 

@@ -13,6 +13,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from scenes import spec as scene_specs
+from scenes.images import read_exr
 from scenes.render import render_pair
 
 
@@ -49,11 +50,11 @@ def print_table_header(title: str, columns: list[str]) -> None:
 
 def scene_list_arguments(description: str, scenes: str) -> argparse.Namespace:
     """Parsed --scenes (comma-separated, default `scenes`), --width (height = width / 2) and
-    --samples (the demo always gets 32)."""
+    --samples (the demo gets at least 32)."""
     ap = argparse.ArgumentParser(description=description, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--scenes", default=scenes)
     ap.add_argument("--width", type=int, default=1024)
-    ap.add_argument("--samples", type=int, default=16, help="Cycles samples (the demo always gets 32)")
+    ap.add_argument("--samples", type=int, default=16, help="Cycles samples (the demo gets at least 32)")
     return ap.parse_args()
 
 
@@ -74,12 +75,22 @@ def ground_truths(args: argparse.Namespace) -> Iterator[GroundTruth]:
     import bpy
 
     from addon.blender import reader
-    from scenes.images import read_exr
 
     for name in args.scenes.split(","):
         spec = scene_specs.get(name).with_render(width=args.width, height=args.width // 2,
-                                                 samples=32 if name == "demo" else args.samples)
+                                                 samples=max(args.samples, 32) if name == "demo" else args.samples)
         paths = render_pair(spec)
         bpy.ops.wm.open_mainfile(filepath=str(paths["blend"]))
         yield GroundTruth(spec, read_exr(paths["input"]), read_exr(paths["truth"]), np.load(paths["mask"]),
                           reader.read_scene(bpy.context.scene))
+
+
+def second_render_structure(gt: GroundTruth, mask: np.ndarray | None = None) -> float:
+    """The structure (`scenes.metrics.structure_correlation`) over `mask` (default: the object's
+    pixels) of the truth rendered again with another seed: what the render's noise alone leaves
+    of a perfect fill's score, the ceiling a fill's structure is read against (rendered unless
+    cached)."""
+    from scenes import metrics
+
+    again = read_exr(render_pair(gt.spec.with_render(seed=gt.spec.render.seed + 1))["truth"])
+    return metrics.structure_correlation(again, gt.truth, gt.mask if mask is None else mask)

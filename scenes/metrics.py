@@ -184,27 +184,32 @@ def summary(input: np.ndarray, edit: np.ndarray, truth: np.ndarray,
     }
 
 
+def detail_ratio(edit: np.ndarray, truth: np.ndarray, mask: np.ndarray) -> float:
+    """Standard deviation over `mask` of the high-pass luminance Y - box_blur3(Y), edit / truth
+    (1 = as much texture; a flat fill gives ~0, noise explosions > 1)."""
+    def high_pass(rgb: np.ndarray) -> np.ndarray:
+        y = luminance(rgb)
+        return (y - box_blur3(y))[mask]
+
+    return float(high_pass(edit).std() / max(high_pass(truth).std(), 1e-30))
+
+
 def hidden_region_scores(input: np.ndarray, edit: np.ndarray, truth: np.ndarray,
                          object_mask: np.ndarray) -> dict[str, float]:
     """How well the region the object hid was filled, by the figures the ground-truth tests bound:
 
     - `mean_ratio`: mean Y_edit / mean Y_truth over the object's pixels (1 = same brightness);
-    - `detail_ratio`: standard deviation of the high-pass Y - box_blur3(Y) over those pixels,
-      edit / truth (1 = as much texture; a flat fill gives ~0, noise explosions > 1);
+    - `detail_ratio`: `detail_ratio` over those pixels;
     - `object_shadow_ratio`: the blurred-Y error sum over the object's pixels and region A
       together, edit / input (how much of the removal's whole error is left);
     - `structure`: `structure_correlation` over the object's pixels (tile and plank lines in
       phase with the truth's)."""
     y_in, y_ed, y_tr = luminance(input), luminance(edit), luminance(truth)
-
-    def high_pass(y: np.ndarray) -> np.ndarray:
-        return (y - box_blur3(y))[object_mask]
-
     region = lighting_region(input, truth, object_mask) | object_mask
     bi, be, bt = box_blur3(y_in), box_blur3(y_ed), box_blur3(y_tr)
     return {
         "mean_ratio": float(y_ed[object_mask].mean() / y_tr[object_mask].mean()),
-        "detail_ratio": float(high_pass(y_ed).std() / max(high_pass(y_tr).std(), 1e-30)),
+        "detail_ratio": detail_ratio(edit, truth, object_mask),
         "object_shadow_ratio": float(np.abs(be - bt)[region].sum() / np.abs(bi - bt)[region].sum()),
         "structure": structure_correlation(edit, truth, object_mask),
     }
