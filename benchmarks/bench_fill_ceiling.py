@@ -4,9 +4,9 @@ what the probe sees of the floor):
     .venv/bin/python benchmarks/bench_fill_ceiling.py [--scenes a,b] [--width 1024] [--samples 16]
 For each of the object's pixels whose ray meets the floor, the floor is followed along the
 planks (the scenes' planks run along x), both ways in 5 mm steps, to the nearest point the probe
-sees (its pixel is not the object's). Two fills of the truth's own pixels, scored as
+sees (its pixel is not the object's). Three fills of the truth's own pixels, scored as
 `bench_fill_groundtruth` scores ours (`scenes.metrics.structure_correlation`) over those floor
-pixels:
+pixels, the truth kept on the object's other pixels:
 - copy: the truth at the nearer of the two points (a shift map's best copy, per pixel);
 - interpolation: linear between the two, each the mean over 3 cm beyond it (as `lines`);
 - the same with grain: plus the truth's pixel detail (the pixel minus its 3x3 mean) at the nearer
@@ -14,7 +14,8 @@ pixels:
   1: what the interpolation scores once it carries grain at the photograph's level, as the
   detail bound asks.
 Each with its detail ratio (`scenes.metrics.detail_ratio`) over those pixels, as ours.
-The last columns are our removal's fill over the same pixels (balanced, exact proxies) and a
+The last columns are our removal's fill over the same pixels (balanced, exact proxies; the truth
+kept elsewhere, as above) and a
 second render of the truth (another seed: its noise alone; `rendered.second_render_structure`).
 Renders are cached (scenes.render); the first run renders what is missing (minutes each).
 """
