@@ -15,8 +15,8 @@ pixels, the truth kept on the object's other pixels:
   detail bound asks.
 Each with its detail ratio (`scenes.metrics.detail_ratio`) over those pixels, as ours.
 The last columns are our removal's fill over the same pixels (balanced, exact proxies; the truth
-kept elsewhere, as above) and a
-second render of the truth (another seed: its noise alone; `rendered.second_render_structure`).
+kept elsewhere, as above) and a second render of the truth (another seed: its noise alone;
+`rendered.second_render_structure`).
 Renders are cached (scenes.render); the first run renders what is missing (minutes each).
 """
 from __future__ import annotations
@@ -75,13 +75,18 @@ def _end_mean(points: np.ndarray, sign: int, truth: np.ndarray) -> np.ndarray:
                     for o in offsets], axis=0)
 
 
-def _scored(values: np.ndarray, truth: np.ndarray, floor: np.ndarray, reached: np.ndarray) -> str:
-    """Structure and detail ratio of the truth with its `floor` pixels replaced by `values`
-    where `reached`, as a table's cell."""
-    from scenes import metrics
-
+def _edited(values: np.ndarray, truth: np.ndarray, floor: np.ndarray, reached: np.ndarray) -> np.ndarray:
+    """The truth with its `floor` pixels replaced by `values` where `reached`."""
     edit = truth.copy()
     edit[floor] = np.where(reached[:, None], values, truth[floor])
+    return edit
+
+
+def _scored(values: np.ndarray, truth: np.ndarray, floor: np.ndarray, reached: np.ndarray) -> str:
+    """Structure and detail ratio of `_edited` over the floor pixels, as a table's cell."""
+    from scenes import metrics
+
+    edit = _edited(values, truth, floor, reached)
     return f"{metrics.structure_correlation(edit, truth, floor):.3f}, {metrics.detail_ratio(edit, truth, floor):.2f}"
 
 
@@ -92,9 +97,7 @@ def _with_grain(values: np.ndarray, grain: np.ndarray, truth: np.ndarray, floor:
     from scenes import metrics
 
     def ratio(scale: float) -> float:
-        edit = truth.copy()
-        edit[floor] = np.where(reached[:, None], values + scale * grain, truth[floor])
-        return metrics.detail_ratio(edit, truth, floor)
+        return metrics.detail_ratio(_edited(values + scale * grain, truth, floor, reached), truth, floor)
 
     bare, full = ratio(0.0), ratio(1.0)
     return values + np.sqrt(max(1.0 - bare**2, 0.0) / max(full**2 - bare**2, 1e-12)) * grain
