@@ -57,3 +57,23 @@ def interpolate_lines(image: np.ndarray, known: np.ndarray, *, axis: int, ends: 
               + t[..., None] * end_value[rows, np.clip(after, 0, w - 1)])
     reached = has_before | has_after
     return LineFill(np.where(reached[..., None], values, 0.0).astype(np.float32), reached)
+
+
+def across_detail(image: np.ndarray, *, axis: int) -> np.ndarray:
+    """(H, W, C) each pixel of `image` minus the mean of it and its two neighbours across the
+    lines along `axis` (edge pixels repeated): the seams and grain streaks a line holds."""
+    across = 1 - axis
+    padded = np.concatenate([np.take(image, [0], axis=across), image, np.take(image, [-1], axis=across)],
+                            axis=across)
+    n = image.shape[across]
+    mean = (np.take(padded, np.arange(n), axis=across) + image + np.take(padded, np.arange(2, n + 2), axis=across)) / 3
+    return image - mean
+
+
+def sharpened_across(values: np.ndarray, filled: np.ndarray, *, axis: int, gain: float) -> np.ndarray:
+    """`values` (H, W, C) with `gain` times their detail across the lines (`across_detail`) added
+    on the `filled` pixels: an unsharp mask across the lines only, since along them an
+    interpolated line holds no detail to restore."""
+    out = values.copy()
+    out[filled] += gain * across_detail(values, axis=axis)[filled]
+    return out

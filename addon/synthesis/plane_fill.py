@@ -15,12 +15,23 @@ import numpy as np
 
 from ..errors import DimredError
 from ..geometry import planeraster
+from .lines import sharpened_across
 from .structure import Filled, fill_structured
 from .texture import SynthesisParams
 
 _MAX_CELLS = 512 * 512  # bounds the raster (and the exemplar) whatever the panorama size
 _DEPTH_TOLERANCE = 0.02  # relative: a cell is where a ray meets its surface within this
 _MIN_KNOWN = 64  # visible cells a surface needs to serve as its own exemplar
+# Planks: the detail across the lines interpolated along them, amplified before they are looked
+# up (`lines.sharpened_across`). At an interpolated line's middle the two ends' grain streaks
+# average to half their spread, and the lookups from the panorama into the raster and back blur
+# what is left (each about a [1/4, 1/2, 1/4] kernel across the lines). Unlike the copies' grain
+# (`structure._PLANK_DETAIL`, weighed 0.9 with it), this detail lies where the truth's does.
+# Against gain 0 with the copies' grain weighed 1.45, at 1024x512 the structure rose by
+# 0.02-0.12 on five plank floors at 64 samples and by 0.02-0.08 on six at 16, the detail ratio
+# staying within 0.80-1.12. Gain 3 gave no more structure (within 0.01) for a detail ratio up
+# to 1.31.
+_LINE_SHARPENING = 2.0
 
 
 @dataclass(frozen=True)
@@ -127,12 +138,20 @@ def fill_surface(
     if filled is None:
         rho = planeraster.sample_raster(raster, image, points)
     else:
-        rho = _with_photograph_detail(planeraster.sample_raster(raster, filled.image, points), panorama, plane,
-                                      raster, _copy_field(filled, image))
+        rho = _with_photograph_detail(planeraster.sample_raster(raster, _sharpened_lines(filled), points),
+                                      panorama, plane, raster, _copy_field(filled, image))
     structure = None if filled is None else filled.structure
     return SurfaceFill(rho=rho, raster_shape=raster.shape, cell=raster.cell, known_cells=int(known.sum()),
                        hole_cells=int(hole.sum()), synthesised=filled is not None,
                        structured=0 if structure is None else int(structure.covered.sum()))
+
+
+def _sharpened_lines(filled: Filled) -> np.ndarray:
+    """The filled raster, its lines along planks (if any) sharpened across them for the lookup."""
+    structure = filled.structure
+    if structure is None or structure.lines is None:
+        return filled.image
+    return sharpened_across(filled.image, structure.lines, axis=structure.along, gain=_LINE_SHARPENING)
 
 
 def _footprint(raster: planeraster.PlaneRaster) -> np.ndarray:

@@ -27,11 +27,11 @@ _TRANSLATIONS = 8  # of the texture's repeats, the best this many are labels (ti
 _SHORT_SHIFTS = (2, 4, 8)  # cells: what a plank changes by along its length and across it
 _PLANK_ANISOTROPY = 0.8  # planks: the texture changes along one axis at most this share of across it
 _LINE_ENDS = 6  # cells averaged at each visible end of a line along the planks (3: -0.02-0.07 in structure)
-# The copies' detail finer than the raster, on planks: with the raster's own share of it gone
-# from the interpolated lines, the detail ratio was 0.66-0.79 at 1024x512 with weight 1, 0.80-0.99
-# with 1.3, 0.88-1.08 with 1.45 (centred in its bound on six plank floors), for 0.02-0.04 of
-# structure against weight 1.
-_PLANK_DETAIL = 1.45
+# The copies' detail finer than the raster, on planks, over the lines sharpened where they are
+# looked up (`plane_fill._LINE_SHARPENING`): detail ratio
+# 0.77-1.09 with weight 0.8, 0.80-1.12 with 0.9, 0.84-1.16 with 1.0 on those floors. The copies'
+# grain is not the truth's: each 0.1 of weight costs up to 0.01 of structure.
+_PLANK_DETAIL = 0.9
 
 
 @dataclass(frozen=True)
@@ -40,12 +40,15 @@ class StructureFill:
     them); `shifts` the shift map behind it (its `image`: what it copied there).
     `detail` weighs the photograph's own detail that a lookup finer than the raster adds to
     `image` there: the copy read from the photograph minus the same copy in the raster
-    (`plane_fill`)."""
+    (`plane_fill`). On planks, `lines` (H, W) are the pixels interpolated along the raster axis
+    `along` (`lines`); None elsewhere."""
 
     image: np.ndarray
     shifts: ShiftMap
     translations: Translations
     detail: float = 1.0
+    along: int | None = None
+    lines: np.ndarray | None = None
 
     @property
     def covered(self) -> np.ndarray:
@@ -92,7 +95,8 @@ def structure_fill(image: np.ndarray, known: np.ndarray, hole: np.ndarray, *, fo
         correction = membrane(clip_outliers(values, fixed), fixed, blended) if fixed.any() else 0.0
         out[blended] = (composed.image + correction)[blended]
     return StructureFill(image=out.astype(np.float32), shifts=composed,
-                         translations=translations, detail=1.0 if along is None else _PLANK_DETAIL)
+                         translations=translations, detail=1.0 if along is None else _PLANK_DETAIL,
+                         along=along, lines=None if along is None else interpolated)
 
 
 @dataclass(frozen=True)

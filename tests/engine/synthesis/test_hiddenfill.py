@@ -2,6 +2,7 @@
 import numpy as np
 
 from addon.geometry import latlong
+from addon.synthesis import plane_fill
 from addon.synthesis.plane_fill import FillOptions, HiddenPlane, PanoramaMaps, PanoramaReflectance, fill_surface
 from addon.synthesis.texture import SynthesisParams
 from tests.engine.geometry.test_planeraster import maps
@@ -67,3 +68,31 @@ def test_a_synthesised_fill_keeps_the_photographs_fine_detail():
     assert got.synthesised and got.structured == 0
     assert 0.8 * 0.05 < got.rho[:, 0].std() < 1.25 * 0.05
     assert abs(got.rho[:, 0].mean() - 0.5) < 0.01
+
+
+def plank_rho(points, width=0.06):
+    """Planks along x, 6 cm wide, each of its own shade, with a dark seam along one side."""
+    k = np.floor(points[..., 1] / width)
+    shade = np.where(points[..., 1] / width - k < 0.15, 0.12, 0.35 + 0.3 * ((k * 0.618034) % 1.0))
+    return shade[..., None] * np.array([1.0, 0.8, 0.6])
+
+
+def test_the_planks_lines_keep_their_contrast_through_the_lookups(monkeypatch):
+    """The lines interpolated along the planks are looked up from the raster bilinearly, which
+    blurs their seams across; sharpened across them first, the fill's contrast between seams
+    and planks comes nearer the truth's, its lines still where the truth's are."""
+    panorama_maps, _, valid, floor, _ = setup()
+    points = latlong.pixel_directions(WIDTH, WIDTH // 2) * panorama_maps.distance_without[..., None]
+    panorama = PanoramaReflectance(plank_rho(points), valid, panorama_maps)
+    planks = HiddenPlane(surface=0, normal=floor.normal, points=floor.points, along=np.array([1.0, 0.0, 0.0]))
+    truth = plank_rho(floor.points)[:, 0]
+
+    def slope_and_correlation(gain):
+        monkeypatch.setattr(plane_fill, "_LINE_SHARPENING", gain)
+        got = fill_surface(panorama, planks, FillOptions(cell=0.01, margin=1.5, synthesis=SynthesisParams()))
+        assert got.structured == got.hole_cells
+        a, b = got.rho[:, 0] - got.rho[:, 0].mean(), truth - truth.mean()
+        return (a * b).sum() / (b * b).sum(), np.corrcoef(a, b)[0, 1]
+
+    (slope_plain, correlation_plain), (slope, correlation) = slope_and_correlation(0.0), slope_and_correlation(2.0)
+    assert slope_plain + 0.05 < slope < 1.0 and correlation > correlation_plain - 0.02

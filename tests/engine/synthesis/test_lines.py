@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from addon.synthesis.lines import along_mean, interpolate_lines
+from addon.synthesis.lines import across_detail, along_mean, interpolate_lines, sharpened_across
 
 
 def _plank_shades(seed=0, shape=(40, 90)):
@@ -58,3 +58,39 @@ def test_along_mean_is_the_mean_over_the_mask_within_the_radius():
             np.testing.assert_allclose(got[r, c], want, rtol=1e-5, atol=1e-6)
     np.testing.assert_allclose(along_mean(image.transpose(1, 0, 2), mask.T, axis=0, radius=3),
                                got.transpose(1, 0, 2), rtol=1e-6)
+
+
+def _blurred_across(image, axis):
+    """`image` blurred twice across its lines by [1/4, 1/2, 1/4] (edges repeated): the two
+    bilinear lookups a fill goes through, panorama to raster and back."""
+    for _ in range(2):
+        image = image - 0.75 * across_detail(image, axis=axis)  # 1/4, 1/2, 1/4 = v - 3/4 (v - mean3)
+    return image
+
+
+@pytest.mark.parametrize("axis", [0, 1])
+def test_sharpening_across_the_lines_restores_blurred_seams_and_leaves_the_rest(axis):
+    _, known = _plank_shades()
+    seams = np.where(np.arange(40) % 6 == 0, 0.4, 1.0)  # planks 6 px wide, each with its own shade
+    shade = np.repeat(0.3 + 0.4 * np.random.default_rng(4).random(7), 6)[:40] * seams
+    along = 1 + 0.01 * np.arange(90)  # and a change along them
+    ramp = (shade[:, None] * along[None, :])[..., None] * np.array([1.0, 0.8, 0.6], np.float32)
+    flat = np.broadcast_to(along[None, :, None], ramp.shape).astype(np.float32)
+    if axis == 0:
+        ramp, flat, known = ramp.transpose(1, 0, 2), flat.transpose(1, 0, 2), known.T
+    blurred = _blurred_across(ramp, axis)
+    got = sharpened_across(blurred, ~known, axis=axis, gain=2.0)
+    hole = ~known
+    inner = hole & np.roll(hole, 1, axis=1 - axis) & np.roll(hole, -1, axis=1 - axis)  # neighbours across in it
+    truth = across_detail(ramp, axis=axis)[inner].ravel()
+
+    def spread_and_correlation(x):
+        d = across_detail(x, axis=axis)[inner].ravel()
+        return d.std() / truth.std(), np.corrcoef(d, truth)[0, 1]
+
+    (spread_before, correlation_before), (spread, correlation) = map(spread_and_correlation, (blurred, got))
+    assert spread > 1.5 * spread_before and correlation > correlation_before + 0.05
+    assert np.abs(got - ramp)[inner].mean() <= np.abs(blurred - ramp)[inner].mean()
+    np.testing.assert_array_equal(got[known], blurred[known])
+    # a field that changes along the lines only holds nothing across them to sharpen
+    np.testing.assert_allclose(sharpened_across(flat, ~known, axis=axis, gain=2.0), flat, atol=1e-6)

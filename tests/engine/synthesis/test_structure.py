@@ -258,6 +258,8 @@ def test_each_plank_keeps_its_own_shade_across_the_hole(transpose):
         truth, hole, inner = truth.transpose(1, 0, 2), hole.T, inner.T
     got = structure_fill(np.where(hole[..., None], 0, truth), ~hole, hole)
     assert got.covered[hole].all() and got.detail == structure._PLANK_DETAIL
+    assert got.along == (0 if transpose else 1) and got.lines[hole].all() and not got.lines[~hole].any()
     interpolated, copied = (float(np.abs(a - truth)[inner].mean()) for a in (got.image, got.shifts.image))
     assert interpolated < 0.5 * copied
-    assert structure_fill(np.where(hole[..., None], 0, _tiles()), ~hole, hole).detail == 1.0
+    tiles = structure_fill(np.where(hole[..., None], 0, _tiles()), ~hole, hole)
+    assert tiles.detail == 1.0 and tiles.along is None and tiles.lines is None
