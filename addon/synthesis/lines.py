@@ -60,14 +60,9 @@ def interpolate_lines(image: np.ndarray, known: np.ndarray, *, axis: int, ends: 
 
 
 def across_detail(image: np.ndarray, *, axis: int) -> np.ndarray:
-    """(H, W, C) each pixel of `image` minus the mean of it and its two neighbours across the
-    lines along `axis` (edge pixels repeated): the seams and grain streaks a line holds."""
-    across = 1 - axis
-    padded = np.concatenate([np.take(image, [0], axis=across), image, np.take(image, [-1], axis=across)],
-                            axis=across)
-    n = image.shape[across]
-    mean = (np.take(padded, np.arange(n), axis=across) + image + np.take(padded, np.arange(2, n + 2), axis=across)) / 3
-    return image - mean
+    """(H, W, C) each pixel of `image` minus the mean of it and its neighbours across the lines
+    along `axis` (`along_mean` across them, radius 1): the seams and grain streaks a line holds."""
+    return image - along_mean(image, np.ones(image.shape[:2], bool), axis=1 - axis, radius=1)
 
 
 def sharpened_across(values: np.ndarray, filled: np.ndarray, *, axis: int, gain: float) -> np.ndarray:
