@@ -14,24 +14,35 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import DimredError
-from ..geometry import planeraster
+from ..geometry import latlong, planeraster
+from ..light.radiosity import LUMA
+from ..segmentation.masks import box_mean
 from .lines import sharpened_across
+from .plank_profile import PlankProfile, fold_profile
 from .structure import Filled, fill_structured
 from .texture import SynthesisParams
 
 _MAX_CELLS = 512 * 512  # bounds the raster (and the exemplar) whatever the panorama size
 _DEPTH_TOLERANCE = 0.02  # relative: a cell is where a ray meets its surface within this
 _MIN_KNOWN = 64  # visible cells a surface needs to serve as its own exemplar
-# Planks: the detail across the lines interpolated along them, amplified before they are looked
-# up (`lines.sharpened_across`). At an interpolated line's middle the two ends' grain streaks
-# average to half their spread, and the lookups from the panorama into the raster and back blur
-# what is left (each about a [1/4, 1/2, 1/4] kernel across the lines). Unlike the copies' grain
-# (`structure._PLANK_DETAIL`, weighed 0.9 with it), this detail lies where the truth's does.
-# Against gain 0 with the copies' grain weighed 1.45, at 1024x512 the structure rose by
-# 0.02-0.12 on five plank floors at 64 samples and by 0.02-0.08 on six at 16, the detail ratio
-# staying within 0.80-1.12. Gain 3 gave no more structure (within 0.01) for a detail ratio up
-# to 1.31.
+# Planks whose profile across them is not found (`plank_profile`): the detail across the lines
+# interpolated along them, amplified before they are looked up (`lines.sharpened_across`). At an
+# interpolated line's middle the two ends' grain streaks average to half their spread, and the
+# lookups from the panorama into the raster and back blur what is left (each about a
+# [1/4, 1/2, 1/4] kernel across the lines). Unlike the copies' grain (`structure._PLANK_DETAIL`,
+# weighed 0.9 with it), this detail lies where the truth's does. Against gain 0 with the copies'
+# grain weighed 1.45, at 1024x512 the structure rose by 0.02-0.12 on five plank floors at 64
+# samples and by 0.02-0.08 on six at 16, the detail ratio staying within 0.80-1.12. Gain 3 gave
+# no more structure (within 0.01) for a detail ratio up to 1.31.
 _LINE_SHARPENING = 2.0
+# Planks whose profile is found: the profile gives the lines their seams, neither sharpened nor
+# much grain over them. At 1024x512 on six plank floors at 16 samples (the demo at 32), the
+# copies' grain weighed 0, 0.3 and 0.45 gave structure 0.70-0.74, 0.69-0.74 and 0.69-0.73 for
+# detail ratios 0.78-0.85, 0.81-0.91 and 0.84-0.96; sharpened too (gain 1, weight 0) 0.67-0.73.
+_PROFILED_DETAIL = 0.45
+_PROFILE_PIXELS = 400_000  # seen pixels gathered for the planks' profile at most
+# cells: the mean a pixel's own detail is taken against (1 or 3: within 0.02 in structure)
+_PROFILE_MEAN_RADIUS = 2
 
 
 @dataclass(frozen=True)
@@ -138,8 +149,7 @@ def fill_surface(
     if filled is None:
         rho = planeraster.sample_raster(raster, image, points)
     else:
-        rho = _with_photograph_detail(planeraster.sample_raster(raster, _sharpened_lines(filled), points),
-                                      panorama, plane, raster, _copy_field(filled, image))
+        rho = _filled_rho(filled, panorama, plane, raster, image, known)
     structure = None if filled is None else filled.structure
     return SurfaceFill(rho=rho, raster_shape=raster.shape, cell=raster.cell, known_cells=int(known.sum()),
                        hole_cells=int(hole.sum()), synthesised=filled is not None,
@@ -152,6 +162,67 @@ def _sharpened_lines(filled: Filled) -> np.ndarray:
     if structure is None or structure.lines is None:
         return filled.image
     return sharpened_across(filled.image, structure.lines, axis=structure.along, gain=_LINE_SHARPENING)
+
+
+def _filled_rho(filled: Filled, panorama: PanoramaReflectance, plane: HiddenPlane, raster: planeraster.PlaneRaster,
+                image: np.ndarray, known: np.ndarray) -> np.ndarray:
+    """(N, 3) the filled raster at the plane's hidden points, with the photograph's detail finer
+    than the raster (`_with_photograph_detail`). On planks, the lines interpolated along them
+    take the planks' profile across them (`plank_profile`) where one is found; where none is,
+    they are sharpened across instead and the copies' grain weighs more."""
+    structure = filled.structure
+    profile, across = None, None
+    if structure is not None and structure.lines is not None:
+        across = _along(raster, 1 - structure.along)
+        profile = _plank_profile(panorama, plane, raster, image, known, structure.along)
+    if profile is None:
+        rho = planeraster.sample_raster(raster, _sharpened_lines(filled), plane.points)
+        weight = 1.0 if structure is None else structure.detail
+        return _with_photograph_detail(rho, panorama, plane, raster, _copy_field(filled, image, weight))
+    rho = planeraster.sample_raster(raster, filled.image, plane.points)
+    rho = _with_photograph_detail(rho, panorama, plane, raster, _copy_field(filled, image, _PROFILED_DETAIL))
+    on_lines = structure.lines[_nearest_cells(raster, plane.points)]
+    hidden = plane.points[on_lines]
+    rho[on_lines] *= profile.at(hidden @ across, hidden @ _along(raster, structure.along))[:, None]
+    return rho
+
+
+def _nearest_cells(raster: planeraster.PlaneRaster, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(row, column) of the raster's cell nearest each point (clamped to the raster)."""
+    return tuple(np.clip(np.rint(x).astype(np.int64), 0, n - 1)
+                 for x, n in zip(raster.coords(points), raster.shape, strict=True))
+
+
+def _plank_profile(panorama: PanoramaReflectance, plane: HiddenPlane, raster: planeraster.PlaneRaster,
+                   image: np.ndarray, known: np.ndarray, along: int) -> PlankProfile | None:
+    """The profile across the planks (along raster axis `along`) of the plane's pixels seen on the raster:
+    each pixel's reflectance over the raster's mean around it (its own fine detail, free of the
+    light and of the planks' shades), folded over the planks' width."""
+    maps = panorama.maps
+    seen = panorama.valid & (maps.surface_with == plane.surface) & ~maps.hidden
+    rows, cols = np.nonzero(seen)
+    if len(rows) > _PROFILE_PIXELS:
+        pick = np.sort(np.random.default_rng(0).choice(len(rows), _PROFILE_PIXELS, replace=False))
+        rows, cols = rows[pick], cols[pick]
+    frame = maps.frame or planeraster.Frame.whole(seen.shape)
+    directions = latlong.pixel_directions_at(rows + frame.row0, np.mod(cols + frame.col0, frame.width), frame.width,
+                                             frame.height)
+    points = directions * maps.distance_with[rows, cols][:, None]
+    row, col = raster.coords(points)
+    h, w = raster.shape
+    inside = (row >= 0) & (row <= h - 1) & (col >= 0) & (col <= w - 1)
+    mean, _ = box_mean(image, known, _PROFILE_MEAN_RADIUS)
+    local = planeraster.sample_raster(raster, mean, points[inside]) @ LUMA
+    value = panorama.rho[rows[inside], cols[inside]] @ LUMA
+    ok = local > 1e-6 * max(float(local.max(initial=0.0)), 1e-30)
+    seen_points = points[inside][ok]
+    return fold_profile(seen_points @ _along(raster, 1 - along), seen_points @ _along(raster, along),
+                        value[ok] / local[ok], min_width=4 * raster.cell)
+
+
+def _along(raster: planeraster.PlaneRaster, axis: int) -> np.ndarray:
+    """The unit direction on the plane along raster axis `axis` (0: rows, 1: columns)."""
+    return raster.u if axis == 1 else raster.v
 
 
 def _footprint(raster: planeraster.PlaneRaster) -> np.ndarray:
@@ -176,9 +247,10 @@ class _CopyField:
     exemplar: np.ndarray
 
 
-def _copy_field(filled: Filled, exemplar: np.ndarray) -> _CopyField:
-    """Where the fill copied each cell from: the shift map's shifts where composed, the
-    synthesis's sources (pixels of `exemplar`, the raster before the fill) elsewhere."""
+def _copy_field(filled: Filled, exemplar: np.ndarray, composed_detail: float) -> _CopyField:
+    """Where the fill copied each cell from: the shift map's shifts where composed (their
+    detail weighed `composed_detail`), the synthesis's sources (pixels of `exemplar`, the raster
+    before the fill) elsewhere."""
     sources, structure = filled.sources, filled.structure
     copied = sources[..., 0] >= 0
     shift = np.where(copied[..., None], sources - np.indices(copied.shape).transpose(1, 2, 0), 0)
@@ -186,7 +258,7 @@ def _copy_field(filled: Filled, exemplar: np.ndarray) -> _CopyField:
     if structure is not None:
         covered = structure.covered
         shift[covered] = structure.shifts.shifts[structure.shifts.labels[covered]]
-        detail[covered] = structure.detail
+        detail[covered] = composed_detail
         copied = copied | covered
     return _CopyField(shift, copied, detail, exemplar)
 
@@ -204,8 +276,7 @@ def _with_photograph_detail(rho: np.ndarray, panorama: PanoramaReflectance, plan
     this one 0.87-1.03, for 0.00-0.02 of structure (the copy's grain is its own, not the
     truth's). Sharper lookups that move or blur the copy did worse (README, "Structure first")."""
     maps = panorama.maps
-    r, c = (np.clip(np.rint(x).astype(np.int64), 0, n - 1) for x, n in zip(raster.coords(plane.points), raster.shape,
-                                                                            strict=True))
+    r, c = _nearest_cells(raster, plane.points)
     sel = np.flatnonzero(field.copied[r, c])
     if not len(sel):
         return rho

@@ -27,8 +27,9 @@ _TRANSLATIONS = 8  # of the texture's repeats, the best this many are labels (ti
 _SHORT_SHIFTS = (2, 4, 8)  # cells: what a plank changes by along its length and across it
 _PLANK_ANISOTROPY = 0.8  # planks: the texture changes along one axis at most this share of across it
 _LINE_ENDS = 6  # cells averaged at each visible end of a line along the planks (3: -0.02-0.07 in structure)
-# The copies' detail finer than the raster, on planks, over the lines sharpened where they are
-# looked up (`plane_fill._LINE_SHARPENING`): on six plank floors at 1024x512 (16 and 64 samples)
+# The copies' detail finer than the raster, on planks whose profile is not found, over the lines
+# sharpened where they are looked up (`plane_fill._LINE_SHARPENING`; with the profile,
+# `plane_fill._PROFILED_DETAIL`): on six plank floors at 1024x512 (16 and 64 samples)
 # the detail ratio was 0.77-1.09 with weight 0.8, 0.80-1.12 with 0.9, 0.84-1.16 with 1.0. The
 # copies' grain is not the truth's: each 0.1 of weight costs up to 0.01 of structure.
 _PLANK_DETAIL = 0.9

@@ -80,7 +80,9 @@ def plank_rho(points, width=0.06):
 def test_the_planks_lines_keep_their_contrast_through_the_lookups(monkeypatch):
     """The lines interpolated along the planks are looked up from the raster bilinearly, which
     blurs their seams across; sharpened across them first, the fill's contrast between seams
-    and planks comes nearer the truth's, its lines still where the truth's are."""
+    and planks comes nearer the truth's, its lines still where the truth's are. (Where the
+    planks' profile is found it gives the seams instead: here it is not looked for.)"""
+    monkeypatch.setattr(plane_fill, "_plank_profile", lambda *_: None)
     panorama_maps, _, valid, floor, _ = setup()
     points = latlong.pixel_directions(WIDTH, WIDTH // 2) * panorama_maps.distance_without[..., None]
     panorama = PanoramaReflectance(plank_rho(points), valid, panorama_maps)
@@ -96,3 +98,30 @@ def test_the_planks_lines_keep_their_contrast_through_the_lookups(monkeypatch):
 
     (slope_plain, correlation_plain), (slope, correlation) = slope_and_correlation(0.0), slope_and_correlation(2.0)
     assert slope_plain + 0.05 < slope < 1.0 and correlation > correlation_plain - 0.02
+
+
+def thin_seam_rho(points, width=0.07, seam=0.008):
+    """Planks along x, 7 cm wide and of one shade, their seams 8 mm wide: thinner than a pixel,
+    seen in a pixel only where its centre falls on them (as a point-sampled render sees them)."""
+    on_seam = np.mod(points[..., 1], width) < seam
+    return np.where(on_seam, 0.1, 0.5)[..., None] * np.array([1.0, 0.8, 0.6])
+
+
+def test_seams_thinner_than_a_pixel_darken_the_hidden_pixels_on_them(monkeypatch):
+    """Interpolated along the planks, a seam thinner than a pixel comes out a faint line at the
+    raster's resolution; folded over the planks' width, the visible floor resolves it, and the
+    fill darkens the hidden pixels whose centres fall on a seam, as the photograph would."""
+    panorama_maps, _, valid, floor, _ = setup()
+    points = latlong.pixel_directions(WIDTH, WIDTH // 2) * panorama_maps.distance_without[..., None]
+    panorama = PanoramaReflectance(thin_seam_rho(points), valid, panorama_maps)
+    planks = HiddenPlane(surface=0, normal=floor.normal, points=floor.points, along=np.array([1.0, 0.0, 0.0]))
+    truth = thin_seam_rho(floor.points)[:, 0]
+    options = FillOptions(cell=0.01, margin=1.5, synthesis=SynthesisParams())
+    profiled = fill_surface(panorama, planks, options).rho[:, 0]
+    monkeypatch.setattr(plane_fill, "_plank_profile", lambda *_: None)
+    interpolated = fill_surface(panorama, planks, options).rho[:, 0]
+    on_seam = truth < 0.3
+    assert 10 < on_seam.sum() < 0.2 * len(truth)
+    correlation = np.corrcoef(profiled, truth)[0, 1]
+    assert correlation > 0.9 and correlation > np.corrcoef(interpolated, truth)[0, 1] + 0.3
+    assert profiled[on_seam].mean() < 0.25 and abs(profiled.mean() / truth.mean() - 1) < 0.05
