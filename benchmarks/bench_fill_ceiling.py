@@ -1,6 +1,8 @@
-"""What a fill made from the visible floor can reach in structure on plank floors, measured on
-the truth itself (the render without the object: no lighting estimate, no reflectance, only
-what the probe sees of the floor):
+"""What fills interpolated along the planks from the visible floor reach in structure on plank
+floors, measured on the truth itself (the render without the object: no lighting estimate, no
+reflectance, only what the probe sees of the floor). No ceiling for ours: these interpolate the
+pixels seen at the hole's ends, whose seams (thinner than a pixel) are seen at other pixels than
+the hidden ones, where our planks' profile draws them at the hidden pixels' own positions:
     .venv/bin/python benchmarks/bench_fill_ceiling.py [--scenes a,b] [--width 1024] [--samples 16]
 For each of the object's pixels whose ray meets the floor, the floor is followed along the
 planks (the scenes' planks run along x), both ways in 5 mm steps, to the nearest point the probe
