@@ -29,6 +29,8 @@ _MIN_SIGNIFICANCE = 4.0  # the profile's between-bin variance over what noise al
 _SAMPLES = 200_000  # pixels folded at most (a random subset beyond: 16K panoramas see millions)
 _SEARCH_SAMPLES = 40_000  # ... while refining the width
 _CHUNK = 64  # candidate widths folded at once
+_COARSE = 4  # the width's first search folds into this many times fewer bins, and each pass then
+# searches this many of its steps each side of the last width
 _ALIGNMENTS = 2  # passes of the shear from the seams' phases and the width from their autocorrelation
 _REFINEMENTS = 3  # passes of shear and width, the shear's step halved each time
 _SHEAR_STEPS = 4  # shears tried each side of the last, a step moving the farthest pixel half a bin
@@ -91,7 +93,7 @@ def fold_profile(across: np.ndarray, along: np.ndarray, detail: np.ndarray, *,
     search = _subset(len(across), _SEARCH_SAMPLES, np.random.default_rng(1))
     cross, length, value = across[search], along[search], detail[search]
     spread = 1.5 * lo / _LAG_BINS
-    width = _best_width(cross - shear * length, value, lag - spread, lag + spread, bins)
+    width = _best_width(cross - shear * length, value, lag - spread, lag + spread, bins // _COARSE)
     # the shear measured from the phases can be off by a few millimetres over the floor (the
     # planks' shades and grain weigh in): refined, with the width, to the fold that orders best
     step = 0.5 * width / bins / max(float(np.ptp(length)), 1e-9)
@@ -99,7 +101,7 @@ def fold_profile(across: np.ndarray, along: np.ndarray, detail: np.ndarray, *,
         shears = np.append(shear + step * np.arange(-_SHEAR_STEPS, _SHEAR_STEPS + 1), 0.0)
         positions = cross[None, :] - shears[:, None] * length[None, :]
         shear = float(shears[np.argmax(_order(positions, value, np.full(len(shears), width), bins))])
-        spread = 2.0 * _DRIFT * width**2 / (bins * float(np.ptp(cross)))
+        spread = _COARSE * _DRIFT * width**2 / (bins * float(np.ptp(cross)))
         width = _best_width(cross - shear * length, value, width - spread, width + spread, bins)
         step /= 2
     position = across - shear * along
