@@ -195,9 +195,9 @@ def _nearest_cells(raster: planeraster.PlaneRaster, points: np.ndarray) -> tuple
 
 def _plank_profile(panorama: PanoramaReflectance, plane: HiddenPlane, raster: planeraster.PlaneRaster,
                    image: np.ndarray, known: np.ndarray, along: int) -> PlankProfile | None:
-    """The profile across the planks (along raster axis `along`) of the plane's pixels seen on the raster:
-    each pixel's reflectance over the raster's mean around it (its own fine detail, free of the
-    light and of the planks' shades), folded over the planks' width."""
+    """The profile across the planks (which run along raster axis `along`) of the plane's pixels
+    seen on the raster: each pixel's reflectance over the raster's mean around it (its own fine
+    detail, free of the light and of the planks' shades), folded over the planks' width."""
     maps = panorama.maps
     seen = panorama.valid & (maps.surface_with == plane.surface) & ~maps.hidden
     rows, cols = np.nonzero(seen)
