@@ -68,6 +68,11 @@ class PanoramaReflectance:
     valid: np.ndarray
     maps: PanoramaMaps
 
+    def shows(self, surface: int) -> np.ndarray:
+        """(h, w) where the reflectance is measured on `surface` (seen first there: not where
+        the object, or anything else, hides it)."""
+        return self.valid & (self.maps.surface_with == surface)
+
 
 @dataclass(frozen=True)
 class HiddenPlane:
@@ -121,8 +126,7 @@ def fill_surface(
     flags = planeraster.classify(raster, maps.surface_with, maps.distance_with, maps.surface_without,
                                  maps.distance_without, maps.hidden, surface=plane.surface,
                                  tolerance=_DEPTH_TOLERANCE, frame=maps.frame)
-    values, weight = planeraster.sample_panorama(raster, panorama.rho,
-                                                 panorama.valid & (maps.surface_with == plane.surface),
+    values, weight = planeraster.sample_panorama(raster, panorama.rho, panorama.shows(plane.surface),
                                                  frame=maps.frame)
     known = (flags == planeraster.SEEN) & (weight > 0.5)
     # The hidden points are looked up bilinearly: fill the cells around each as well.
@@ -199,7 +203,7 @@ def _plank_profile(panorama: PanoramaReflectance, plane: HiddenPlane, raster: pl
     seen on the raster: each pixel's reflectance over the raster's mean around it (its own fine
     detail, free of the light and of the planks' shades), folded over the planks' width."""
     maps = panorama.maps
-    seen = panorama.valid & (maps.surface_with == plane.surface) & ~maps.hidden
+    seen = panorama.shows(plane.surface)
     rows, cols = np.nonzero(seen)
     if len(rows) > _PROFILE_PIXELS:
         pick = np.sort(np.random.default_rng(0).choice(len(rows), _PROFILE_PIXELS, replace=False))
@@ -211,8 +215,8 @@ def _plank_profile(panorama: PanoramaReflectance, plane: HiddenPlane, raster: pl
     row, col = raster.coords(points)
     h, w = raster.shape
     inside = (row >= 0) & (row <= h - 1) & (col >= 0) & (col <= w - 1)
-    mean, _ = box_mean(image, known, _PROFILE_MEAN_RADIUS)
-    local = planeraster.sample_raster(raster, mean, points[inside]) @ LUMA
+    mean, _ = box_mean((image @ LUMA)[..., None], known, _PROFILE_MEAN_RADIUS)
+    local = planeraster.sample_raster(raster, mean, points[inside])[:, 0]
     value = panorama.rho[rows[inside], cols[inside]] @ LUMA
     ok = local > 1e-6 * max(float(local.max(initial=0.0)), 1e-30)
     seen_points = points[inside][ok]
@@ -282,8 +286,8 @@ def _with_photograph_detail(rho: np.ndarray, panorama: PanoramaReflectance, plan
         return rho
     t = field.shift[r[sel], c[sel]] * raster.cell
     source = plane.points[sel] + t[:, :1] * raster.v + t[:, 1:] * raster.u
-    valid = panorama.valid & (maps.surface_with == plane.surface)
-    copy, weight = planeraster.sample_points_keeping_grain(source, panorama.rho, valid, frame=maps.frame)
+    copy, weight = planeraster.sample_points_keeping_grain(source, panorama.rho, panorama.shows(plane.surface),
+                                                           frame=maps.frame)
     coarse = planeraster.sample_raster(raster, field.exemplar, source)
     ok = weight > 0.5
     out = rho.copy()
