@@ -1,7 +1,9 @@
 """The batch of 20 ground-truth jobs (`scenes.batch`) through each engine: wall seconds, jobs a
 minute, the largest job's peak memory and the batch process's own, and a re-run's seconds.
 
-    .venv/bin/python benchmarks/bench_batch.py [--workers 2] [--check] [--markdown]
+    .venv/bin/python benchmarks/bench_batch.py [--workers 2] [--check]
+
+Prints a table and writes it into docs/results/bench_batch.md.
 
 Rows, each a fresh batch process measured from outside (its rusage): local processes (what
 `blender -c dimred batch` runs), a local Dask cluster (`python -m addon.cli batch`), the same
@@ -26,6 +28,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from results import Table, write
 from scenes.batch import single, write_jobs_file
 from scenes.images import read_exr
 from scenes.render import REPO
@@ -78,7 +81,6 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--check", action="store_true", help="compare every good job with the single command line")
-    parser.add_argument("--markdown", action="store_true")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory(prefix="bench_batch-") as scratch:
         folder = Path(scratch)
@@ -88,29 +90,17 @@ def main() -> None:
                 ("dask-local", args.workers, _batch(jobs_file, folder / "dask", args.workers, "dask")),
                 ("dask-local, re-run", args.workers, _batch(jobs_file, folder / "dask", args.workers, "dask"))]
         base = rows[0][2]["seconds"]
-        table = [COLUMNS]
+        table = Table(COLUMNS, title=f"{len(jobs)} jobs of the batch test (scenes/batch.py)")
         for engine, workers, r in rows:
-            table.append((engine, str(workers), f"{r['seconds']:.1f}", f"{60 * len(jobs) / r['seconds']:.1f}",
-                          f"{base / r['seconds']:.2f}", str(r["done"]), str(r["kept"]), str(r["failed"]),
-                          "" if r["largest"] is None else f"{r['largest']:.2f}", f"{r['own']:.2f}"))
-        _print(table, markdown=args.markdown)
+            table.row(engine, workers, f"{r['seconds']:.1f}", f"{60 * len(jobs) / r['seconds']:.1f}",
+                      f"{base / r['seconds']:.2f}", r["done"], r["kept"], r["failed"],
+                      "" if r["largest"] is None else f"{r['largest']:.2f}", f"{r['own']:.2f}")
+        notes = []
         if args.check:
             same, differ = _check(jobs, folder / "dask", folder / "single")
-            print(f"\n{same} good jobs' difference images equal the single command line's"
-                  + (f"; differ: {', '.join(differ)}" if differ else ""))
-
-
-def _print(table: list[tuple[str, ...]], *, markdown: bool) -> None:
-    if markdown:
-        print("| " + " | ".join(table[0]) + " |")
-        print("|" + "---|" * len(table[0]))
-        for row in table[1:]:
-            print("| " + " | ".join(row) + " |")
-        return
-    widths = [max(len(row[i]) for row in table) for i in range(len(table[0]))]
-    for row in table:
-        print("  ".join(cell.ljust(width) for cell, width in zip(row, widths, strict=True)))
-
+            notes.append(f"{same} good jobs' difference images equal the single command line's"
+                         + (f"; differ: {', '.join(differ)}" if differ else ""))
+        write(table, notes=notes)
 
 if __name__ == "__main__":
     main()

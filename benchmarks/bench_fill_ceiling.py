@@ -28,7 +28,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from rendered import ground_truths, print_table_header, scene_list_arguments, second_render_structure
+from rendered import ground_truths, scene_list_arguments, second_render_structure
+from results import Table, write
 from scenes.spec import SceneSpec
 
 SCENES = "demo,stool,warm_cylinder,oak_chair,walnut_crate,far_pouf"
@@ -128,10 +129,10 @@ def main() -> None:
     from addon.pipeline import remove_object
     from scenes import metrics
 
-    print_table_header(f"{args.width}x{args.width // 2} at {args.samples} samples, structure and detail ratio over"
-                       " the object's floor pixels",
-                       ["scene", "floor pixels", "median distance to seen floor m", "copy", "interpolation",
-                        "interpolation with grain", "interpolation sharpened", "ours", "second render"])
+    table = Table(["scene", "floor pixels", "median distance to seen floor m", "copy", "interpolation",
+                   "interpolation with grain", "interpolation sharpened", "ours", "second render"],
+                  title=f"{args.width}x{args.width // 2} at {args.samples} samples, structure and detail ratio over"
+                        " the object's floor pixels")
     for gt in ground_truths(args):
         s, truth, mask = gt.spec, gt.truth, gt.mask
         if s.room.floor.pattern != "planks" or s.world_rotation_z:
@@ -151,11 +152,11 @@ def main() -> None:
         sharpened = _with_grain(interpolated, (bare - metrics.box_blur3(bare))[floor], truth, floor, reached)
         r = remove_object(gt.scene, s.remove, quality="balanced")
         ours = (gt.input + r.difference)[floor]
-        print(f"| {s.name} | {int(floor.sum())} | {np.median(np.minimum(after, before)[reached]):.2f} "
-              f"| {_scored(copy, truth, floor, reached)} | {_scored(interpolated, truth, floor, reached)} "
-              f"| {_scored(grained, truth, floor, reached)} | {_scored(sharpened, truth, floor, reached)} "
-              f"| {_scored(ours, truth, floor, np.ones_like(reached))} "
-              f"| {second_render_structure(gt, floor):.3f} |", flush=True)
+        table.row(s.name, int(floor.sum()), f"{np.median(np.minimum(after, before)[reached]):.2f}",
+                  _scored(copy, truth, floor, reached), _scored(interpolated, truth, floor, reached),
+                  _scored(grained, truth, floor, reached), _scored(sharpened, truth, floor, reached),
+                  _scored(ours, truth, floor, np.ones_like(reached)), f"{second_render_structure(gt, floor):.3f}")
+    write(table)
 
 
 if __name__ == "__main__":

@@ -9,12 +9,14 @@ the seconds the fill of the revealed surfaces took (`filled_surfaces` in the rep
 report's stages `synthesis` (that fill and its previews) and `hidden_light` (the irradiance
 after the removal at the revealed pixels).
 Renders are cached (scenes.render); the first run renders what is missing (minutes each).
+The table is also written into docs/results/bench_fill_groundtruth.md (`results.write`).
 """
 from __future__ import annotations
 
 import numpy as np
 
-from rendered import FLOOR_SCENES, ground_truths, print_table_header, scene_list_arguments, second_render_structure
+from rendered import FLOOR_SCENES, ground_truths, scene_list_arguments, second_render_structure
+from results import Table, write
 
 
 def main() -> None:
@@ -23,9 +25,9 @@ def main() -> None:
     from addon.pipeline import remove_object
     from scenes import metrics
 
-    print_table_header(f"{args.width}x{args.width // 2} at {args.samples} samples, balanced, exact proxies",
-                       ["scene", "floor", "structure-aware", "structure", "second render", "detail", "mean",
-                        "object + shadow", "NaN", "fill s", "synthesis s", "hidden light s"])
+    table = Table(["scene", "floor", "structure-aware", "structure", "second render", "detail", "mean",
+                   "object + shadow", "NaN", "fill s", "synthesis s", "hidden light s"],
+                  title=f"{args.width}x{args.width // 2} at {args.samples} samples, balanced, exact proxies")
     for gt in ground_truths(args):
         s = gt.spec
         ceiling = second_render_structure(gt)
@@ -34,10 +36,11 @@ def main() -> None:
             edit = gt.input + r.difference
             h = metrics.hidden_region_scores(gt.input, edit, gt.truth, gt.mask)
             fill_s = sum(f["seconds"] for f in r.report["filled_surfaces"])
-            print(f"| {s.name} | {s.room.floor.pattern} | {'on' if structure else 'off'} | {h['structure']:.3f} "
-                  f"| {ceiling:.3f} | {h['detail_ratio']:.2f} | {h['mean_ratio']:.3f} | {h['object_shadow_ratio']:.3f} "
-                  f"| {int(np.isnan(edit).sum())} | {fill_s:.2f} | {r.report['seconds']['synthesis']:.2f} "
-                  f"| {r.report['seconds']['hidden_light']:.2f} |", flush=True)
+            table.row(s.name, s.room.floor.pattern, "on" if structure else "off", f"{h['structure']:.3f}",
+                      f"{ceiling:.3f}", f"{h['detail_ratio']:.2f}", f"{h['mean_ratio']:.3f}",
+                      f"{h['object_shadow_ratio']:.3f}", int(np.isnan(edit).sum()), f"{fill_s:.2f}",
+                      f"{r.report['seconds']['synthesis']:.2f}", f"{r.report['seconds']['hidden_light']:.2f}")
+    write(table)
 
 
 if __name__ == "__main__":

@@ -14,6 +14,7 @@ timer tick, the longest gap between two ticks (the main thread's worst stall, in
 for the interpreter lock the worker holds), the first preview's delay from the start of the
 gathering (the operator's invoke) to the tick that put it in the world, and the total run time.
 The target: no gap over 0.1 s beyond the timer interval, the first preview within 0.5 s.
+The table is also written into docs/results/bench_operator.md (`results.write`).
 """
 from __future__ import annotations
 
@@ -32,6 +33,7 @@ sys.path.insert(0, str(ROOT))
 
 from addon.quality import DEFAULT_QUALITY  # noqa: E402
 from rendered import arguments, open_scene  # noqa: E402
+from results import Table, write  # noqa: E402
 
 POLL_INTERVAL = 0.05
 
@@ -113,13 +115,13 @@ def main() -> None:
     gaps = [b - a for a, b in itertools.pairwise(starts)] or [float("nan")]
     ticks = session.tick_seconds
     width = args.panorama_width or args.width
-    print(f"scene {args.scene} {width}x{width // 2}, quality {args.quality}, small copy {args.cache}, "
-          f"timer every {POLL_INTERVAL} s{', until the first preview' if args.until_preview else ''}")
-    print("| gather s | ticks | longest tick s | mean tick s | longest gap between ticks s "
-          "| first preview s | total s |")
-    print("|---|---|---|---|---|---|---|")
-    print(f"| {gather:.3f} | {len(ticks)} | {max(ticks):.3f} | {sum(ticks) / len(ticks):.4f} | "
-          f"{max(gaps):.3f} | {first_preview if first_preview is not None else float('nan'):.2f} | {total:.2f} |")
+    table = Table(["gather s", "ticks", "longest tick s", "mean tick s", "longest gap between ticks s",
+                   "first preview s", "total s"],
+                  title=f"scene {args.scene} {width}x{width // 2}, quality {args.quality}, small copy {args.cache}, "
+                        f"timer every {POLL_INTERVAL} s{', until the first preview' if args.until_preview else ''}")
+    table.row(f"{gather:.3f}", len(ticks), f"{max(ticks):.3f}", f"{sum(ticks) / len(ticks):.4f}", f"{max(gaps):.3f}",
+              f"{first_preview if first_preview is not None else float('nan'):.2f}", f"{total:.2f}")
+    write(table)
     extension.unregister()
     shutil.rmtree(folder, ignore_errors=True)
 

@@ -7,10 +7,12 @@ outside the object, their relative detail edit / truth (`scenes.metrics.relit_de
 the object + shadow error (`hidden_region_scores`) off and on, the growth k the stage measured
 per surface and its seconds.
 Renders are cached (scenes.render); the first run renders what is missing (minutes each).
+The table is also written into docs/results/bench_relit_noise.md (`results.write`).
 """
 from __future__ import annotations
 
-from rendered import FLOOR_SCENES, ground_truths, print_table_header, scene_list_arguments
+from rendered import FLOOR_SCENES, ground_truths, scene_list_arguments
+from results import Table, write
 
 
 def main() -> None:
@@ -19,9 +21,9 @@ def main() -> None:
     from addon.pipeline import remove_object
     from scenes import metrics
 
-    print_table_header(f"{args.width}x{args.width // 2}, balanced, exact proxies",
-                       ["scene", "relit pixels", "relit detail off", "on", "object + shadow off", "on", "growth k",
-                        "stage s"])
+    table = Table(["scene", "relit pixels", "relit detail off", "on", "object + shadow off", "on", "growth k",
+                   "stage s"],
+                  title=f"{args.width}x{args.width // 2}, balanced, exact proxies")
     for gt in ground_truths(args):
         s = gt.spec
         row = []
@@ -32,8 +34,9 @@ def main() -> None:
             shadow = metrics.hidden_region_scores(gt.input, edit, gt.truth, gt.mask)["object_shadow_ratio"]
             row.append((detail, shadow))
         growth = ", ".join(f"{k:.2f}" for k in r.report["relit_noise"]["growth"].values()) or "-"
-        print(f"| {s.name} | {pixels} | {row[0][0]:.2f} | {row[1][0]:.2f} | {row[0][1]:.3f} | {row[1][1]:.3f} "
-              f"| {growth} | {r.report['seconds']['relit_noise']:.3f} |", flush=True)
+        table.row(s.name, pixels, f"{row[0][0]:.2f}", f"{row[1][0]:.2f}", f"{row[0][1]:.3f}", f"{row[1][1]:.3f}",
+                  growth, f"{r.report['seconds']['relit_noise']:.3f}")
+    write(table)
 
 
 if __name__ == "__main__":

@@ -7,6 +7,7 @@ the best edit smooth at the 3 px scale (the truth's noise), the far damage, and 
 last residual. Default: `basic_box`, 40 degrees, distance x1.3 (the first move of the relocation
 ground-truth tests). Renders are cached under .cache/groundtruth; timings on a shared machine are
 noisy: compare within one run.
+The table is also written into docs/results/bench_relocation.md (`results.write`).
 """
 from __future__ import annotations
 
@@ -17,6 +18,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from rendered import arguments, open_scene
+from results import Table, write
 from scenes import metrics
 from scenes import spec as scene_specs
 from scenes.render import load_pair
@@ -43,10 +45,10 @@ def main() -> None:
     scene = reader.read_scene(bpy.context.scene)
     region = metrics.relocation_region(inp, truth, empty, old_mask, new_mask)
     floor = metrics.noise_floor(inp, truth, old_mask | new_mask, region)
-    print(f"scene {args.scene} {args.width}x{args.width // 2} @ {args.samples} spp; "
-          f"yaw {args.yaw} x{args.distance_scale}; region {int(region.sum())} px; noise floor {floor:.3f}")
-    print("| preset | removal s | insertion s | total s | error ratio | far damage |")
-    print("|---|---|---|---|---|---|")
+    table = Table(["preset", "removal s", "insertion s", "total s", "error ratio", "far damage"],
+                  title=f"scene {args.scene} {args.width}x{args.width // 2} @ {args.samples} spp; "
+                        f"yaw {args.yaw} x{args.distance_scale}; region {int(region.sum())} px; "
+                        f"noise floor {floor:.3f}")
     for preset in args.presets.split(","):
         t0 = time.perf_counter()
         r = relocate_object(scene, spec.remove, Move(args.yaw, args.distance_scale), quality=preset)
@@ -55,7 +57,8 @@ def main() -> None:
         removal = sum(v for k, v in sec.items() if k.startswith("removal_"))
         error = metrics.relocation_error_ratio(inp, r.edited, truth, region)
         far = metrics.far_damage(inp, r.edited, truth, old_mask | new_mask, region=region)
-        print(f"| {preset} | {removal:.2f} | {total - removal:.2f} | {total:.2f} | {error:.3f} | {far:.3f} |")
+        table.row(preset, f"{removal:.2f}", f"{total - removal:.2f}", f"{total:.2f}", f"{error:.3f}", f"{far:.3f}")
+    write(table)
 
 
 if __name__ == "__main__":

@@ -5,6 +5,7 @@ hidden region's scores (`scenes.metrics.hidden_region_scores`).
 The scene is the `basic_box` spec (a 0.5 m box) rendered at 1024x512; the render is cached
 under .cache/groundtruth, so only the first run pays for Cycles. Timings on a shared machine
 are noisy: compare presets within one run.
+The table is also written into docs/results/bench_removal.md (`results.write`).
 """
 from __future__ import annotations
 
@@ -17,6 +18,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from rendered import arguments, open_scene
+from results import Table, write
 from scenes import metrics
 
 
@@ -43,15 +45,14 @@ def main() -> None:
         ratio = metrics.lighting_error_ratio(inp, r.edited, truth, mask)
         rows.append((preset, r.report["seconds"], ratio, metrics.hidden_region_scores(inp, r.edited, truth, mask)))
     stages = [k for k in rows[0][1] if k != "total"]
-    print(f"scene {args.scene} {args.width}x{args.width // 2} @ {args.samples} spp; read_scene {read_s:.2f} s;"
-          f" noise floor {floor:.3f}")
-    print("| preset | " + " | ".join(stages)
-          + " | total s | error ratio | hidden mean | hidden detail | object + shadow |")
-    print("|---" * (len(stages) + 6) + "|")
+    table = Table(["preset", *stages, "total s", "error ratio", "hidden mean", "hidden detail", "object + shadow"],
+                  title=f"scene {args.scene} {args.width}x{args.width // 2} @ {args.samples} spp; "
+                        f"read_scene {read_s:.2f} s; noise floor {floor:.3f}")
     for preset, sec, ratio, hidden in rows:
-        print(f"| {preset} | " + " | ".join(f"{sec[k]:.2f}" for k in stages) + f" | {sec['total']:.2f} | {ratio:.3f}"
-              f" | {hidden['mean_ratio']:.3f} | {hidden['detail_ratio']:.2f} | {hidden['object_shadow_ratio']:.3f} |")
-
+        table.row(preset, *(f"{sec[k]:.2f}" for k in stages), f"{sec['total']:.2f}", f"{ratio:.3f}",
+                  f"{hidden['mean_ratio']:.3f}", f"{hidden['detail_ratio']:.2f}",
+                  f"{hidden['object_shadow_ratio']:.3f}")
+    write(table)
 
 if __name__ == "__main__":
     main()

@@ -8,7 +8,8 @@ the object: total (`object_shadow_ratio`, the error left over the object and its
 (`lighting_error_ratio`), ghost (`ghost_share`, the object's pixels left visibly wrong), far
 damage, pixels with a NaN, the command's seconds, and, where the report holds an alignment, the
 pose error it leaves (`pose_error`). Each case's row gives its difference to the scene's exact
-row; a last table sums the cases up over the scenes. Renders are cached under .cache/groundtruth
+row; a last table sums the cases up over the scenes. Both are written into
+docs/results/bench_rough_proxies.md. Renders are cached under .cache/groundtruth
 (the missing ones are rendered first, about a minute each at 1024x512 and 16 samples).
 """
 from __future__ import annotations
@@ -19,11 +20,11 @@ import math
 import shlex
 import sys
 import tempfile
-from collections.abc import Callable
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from results import Table, write
 from scenes import spec as scene_specs
 from scenes.perturb import CaseResult, ProxyError, parse, run_case
 from scenes.render import render_pair
@@ -33,7 +34,6 @@ CASES = ("exact", "shift 2 cm x", "shift 2 cm y", "shift 5 cm at 45 deg", "turn 
          "scale 1.05", "floor +1 cm", "shift 3 cm at 45 deg + turn 3 deg + scale 0.97")
 COLUMNS = ("scene", "case", "total", "Δ total", "lighting", "Δ lighting", "ghost", "Δ ghost", "far", "NaN", "s",
            "pose left (cm, deg, %)", "failure")
-WIDTHS = (14, 46, 6, 7, 8, 10, 6, 7, 6, 4, 5, 22, 0)
 SCORES = ("total", "lighting", "ghost")
 
 
@@ -47,7 +47,6 @@ def _arguments() -> argparse.Namespace:
                     help="comma-separated proxy errors, each as scenes.perturb spells them; exact is always run first")
     ap.add_argument("--cli-args", default="", help="appended to every remove command, e.g. \"--align\"")
     ap.add_argument("--json", type=Path, metavar="FILE", help="also write every row to FILE")
-    ap.add_argument("--markdown", action="store_true", help="print Markdown tables")
     # argparse takes a value that starts with "--" (--cli-args "--align") for an option of its own.
     argv, given = [], iter(sys.argv[1:])
     for a in given:
@@ -71,32 +70,18 @@ def _cells(row: dict) -> list[str]:
             row["failure"] or ""]
 
 
-def _printer(markdown: bool, columns: tuple[str, ...], widths: tuple[int, ...]) -> Callable[[list[str]], None]:
-    def line(cells: list[str]) -> None:
-        if markdown:
-            print("| " + " | ".join(cells) + " |", flush=True)
-        else:
-            print("  ".join(c.ljust(w) for c, w in zip(cells, widths, strict=True)).rstrip(), flush=True)
-
-    line(list(columns))
-    if markdown:
-        print("|---" * len(columns) + "|")
-    return line
-
-
-def _summary(rows: list[dict], markdown: bool) -> None:
+def _summary(rows: list[dict]) -> Table:
     """Per case over the scenes: mean and worst difference of the total to the exact proxy's,
     mean ghost difference, worst far damage, NaN pixels and failed runs."""
-    print()
-    line = _printer(markdown, ("case", "mean Δ total", "worst Δ total", "mean Δ ghost", "worst far", "NaN", "failed"),
-                    (46, 12, 13, 12, 9, 4, 6))
+    table = Table(("case", "mean Δ total", "worst Δ total", "mean Δ ghost", "worst far", "NaN", "failed"),
+                  title="Per case over the scenes")
     for case in dict.fromkeys(r["case"] for r in rows if r["case"] != "exact"):
         of = [r for r in rows if r["case"] == case]
         ok = [r for r in of if r["failure"] is None]
         d_total, d_ghost = [r["d_total"] for r in ok], [r["d_ghost"] for r in ok]
-        line([case, f"{_mean(d_total):+.3f}", f"{max(d_total, default=math.nan):+.3f}", f"{_mean(d_ghost):+.3f}",
-              f"{max((r['far'] for r in ok), default=math.nan):.3f}", str(sum(r["nans"] for r in ok)),
-              str(len(of) - len(ok))])
+        table.row(case, f"{_mean(d_total):+.3f}", f"{max(d_total, default=math.nan):+.3f}", f"{_mean(d_ghost):+.3f}",
+                  f"{max((r['far'] for r in ok), default=math.nan):.3f}", sum(r["nans"] for r in ok), len(of) - len(ok))
+    return table
 
 
 def _mean(values: list[float]) -> float:
@@ -118,9 +103,8 @@ def main() -> None:
     errors = [ProxyError(), *(e for e in dict.fromkeys(errors) if e != ProxyError())]
     cli_args = shlex.split(args.cli_args)
     pairs = {spec.name: render_pair(spec) for spec in specs}
-    print(f"{args.size}x{args.size // 2} @ {args.samples} spp, quality {args.quality}, "
-          f"cli args {' '.join(cli_args) or '(none)'}; Δ: the case minus the exact proxy", flush=True)
-    line = _printer(args.markdown, COLUMNS, WIDTHS)
+    table = Table(COLUMNS, title=f"{args.size}x{args.size // 2} @ {args.samples} spp, quality {args.quality}, "
+                                 f"cli args {' '.join(cli_args) or '(none)'}; Δ: the case minus the exact proxy")
     rows = []
     for spec in specs:
         exact = None
@@ -130,8 +114,8 @@ def main() -> None:
                                   cli_args=cli_args)
             exact = exact or result
             rows.append(_row(spec.name, result, exact))
-            line(_cells(rows[-1]))
-    _summary(rows, args.markdown)
+            table.row(*_cells(rows[-1]))
+    write(table, _summary(rows))
     if args.json:
         args.json.write_text(json.dumps({"size": args.size, "samples": args.samples, "quality": args.quality,
                                          "cli_args": cli_args, "rows": [_finite(r) for r in rows]}, indent=1))

@@ -1,7 +1,7 @@
 """Seconds and peak memory of a removal per panorama size and per object triangle count.
 
     .venv/bin/python benchmarks/bench_scale.py [--sizes 1024,2048,4096,8192,16384]
-        [--splits 1,9,29,64] [--quality draft,balanced,final] [--engine] [--markdown]
+        [--splits 1,9,29,64] [--quality draft,balanced,final] [--engine]
         [--truth-sizes 2048] [--scene basic_box] [--width 1024] [--samples 8]
         [--working-widths 512,1024,2048]
 
@@ -24,7 +24,7 @@ the same preset (and working width) in the same run; --working-widths repeats ea
 rows with the light solved at those widths (`--working-width`), default the preset's own.
 The targets are 8K within 4x the 1K time and 3 GB, 16K within 8 GB, 49k triangles within 2x
 the 12-triangle time and memory. Timings on a shared machine are noisy: compare the rows of
-one run.
+one run. The table is printed and written into docs/results/bench_scale.md.
 """
 from __future__ import annotations
 
@@ -43,6 +43,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from rendered import arguments
+from results import Table, write
 from scenes import metrics
 from scenes import spec as scene_specs
 from scenes.images import read_exr
@@ -233,18 +234,6 @@ def _cells(preset: Preset, engine: bool, case: Case, run: Measured, base: Measur
             ", ".join(f"{k} {v:.1f}" for v, k in slowest)]
 
 
-def _print_table(rows: list[list[str]], markdown: bool) -> None:
-    if markdown:
-        print("| " + " | ".join(COLUMNS) + " |")
-        print("|" + "---|" * len(COLUMNS))
-        for row in rows:
-            print("| " + " | ".join(row) + " |")
-        return
-    widths = [max(len(r[i]) for r in [list(COLUMNS), *rows]) for i in range(len(COLUMNS))]
-    for row in [list(COLUMNS), *rows]:
-        print("  ".join(cell.ljust(w) for cell, w in zip(row, widths, strict=True)).rstrip())
-
-
 def _ints(text: str) -> list[int]:
     return [int(x) for x in text.split(",") if x]
 
@@ -259,7 +248,6 @@ def main() -> None:
     ap.add_argument("--truth-sizes", default="2048", help="widths also rendered with Cycles, so scored")
     ap.add_argument("--working-widths", default="", help="working widths, comma-separated (default: the preset's)")
     ap.add_argument("--engine", action="store_true", help="the engine alone instead of the command line")
-    ap.add_argument("--markdown", action="store_true", help="print the table as markdown")
     ap.add_argument("--setup", type=Path, help=argparse.SUPPRESS)
     ap.add_argument("--blend", type=Path, help=argparse.SUPPRESS)
     ap.add_argument("--working-width", type=int, help=argparse.SUPPRESS)
@@ -282,8 +270,6 @@ def main() -> None:
     cases = _cases(args)
     pair = cases[0].pair
     floor = metrics.noise_floor(read_exr(pair["input"]), read_exr(pair["truth"]), np.load(pair["mask"]))
-    print(f"scene {args.scene} rendered {args.width}x{args.width // 2} @ {args.samples} spp; noise floor {floor:.3f}; "
-          f"seconds: process wall time; peak memory: its maximum resident set")
     rows = []
     with tempfile.TemporaryDirectory() as folder:
         widths = _ints(args.working_widths) or [None]
@@ -293,7 +279,12 @@ def main() -> None:
                 run = base if case is cases[0] else _run(case, name, preset, args.engine, Path(folder))
                 rows.append(_cells(preset, args.engine, case, run, base))
                 print(" | ".join(rows[-1]), file=sys.stderr, flush=True)
-    _print_table(rows, args.markdown)
+    table = Table(COLUMNS, title=f"scene {args.scene} rendered {args.width}x{args.width // 2} @ {args.samples} spp; "
+                                 f"noise floor {floor:.3f}; seconds: process wall time; peak memory: its maximum "
+                                 "resident set")
+    for row in rows:
+        table.row(*row)
+    write(table)
 
 
 if __name__ == "__main__":

@@ -1,7 +1,8 @@
 """Seconds and quality of hole filling: our synthesis (accelerated and exhaustive) and the 2D fills
 people use today, on procedural floor textures with a square hole in the middle.
 
-Prints a markdown table per case and a summary per method and hole size. Quality against the
+Prints a markdown table per case and a summary per method and hole size (both also written into
+docs/results/bench_synthesis.md). Quality against the
 known truth inside the hole: structure (correlation of the fill's band-pass luminance, box blur
 of radius 1 minus box blur of radius 4, with the truth's: 1 = edges and lines where they really
 run, 0 = out of phase or flat; `scenes.metrics.structure_correlation`), MAE (mean absolute
@@ -47,6 +48,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from addon.synthesis.structure import fill_structured
 from addon.synthesis.texture import SynthesisParams, fill
+from results import Table, write
 from scenes.metrics import structure_correlation
 from textures import DEFAULT, TEXTURES, lighting
 
@@ -181,10 +183,9 @@ def main() -> None:
     if args.methods:
         methods = {name: methods[name] for name in args.methods.split(",")}
 
-    print(f"{args.image}x{args.image} images, square hole in the middle; default parameters {SynthesisParams()}")
-    print()
-    print("| case | texture | hole | method | s | structure | MAE | detail | seam |")
-    print("|---|---|---|---|---|---|---|---|---|")
+    table = Table(("case", "texture", "hole", "method", "s", "structure", "MAE", "detail", "seam"),
+                  title=f"{args.image}x{args.image} images, square hole in the middle; "
+                        f"default parameters {SynthesisParams()}")
     rows = []
     for case in args.cases.split(","):
         for texture in args.textures.split(","):
@@ -195,11 +196,11 @@ def main() -> None:
                 hole[lo:lo + size, lo:lo + size] = True
                 truth, seen, lit, after = case_inputs(case, floor, hole)  # the hole's truth is never seen
                 for name, method in methods.items():
-                    label = f"| {case} | {texture} | {size} | {name} |"
+                    label = (case, texture, size, name)
                     if isinstance(method, str) or (name == "ours exhaustive" and size > exhaustive_max):
                         why = method if isinstance(method, str) else (
                             "skipped (--quick)" if args.quick else f"skipped (holes <= {exhaustive_max} px only)")
-                        print(f"{label} {why} | | | | |", flush=True)
+                        table.row(*label, why, "", "", "", "")
                         continue
                     seconds = np.inf
                     for _ in range(args.repeat):  # every method is deterministic: the runs differ in time only
@@ -212,22 +213,20 @@ def main() -> None:
                         seconds = min(seconds, time.perf_counter() - t0)
                     structure, mae, detail, seam = quality(np.where(hole[..., None], out, truth), truth, hole)
                     rows.append((case, name, size, seconds, structure, mae, detail, seam))
-                    print(f"{label} {seconds:.2f} | {structure:.2f} | {mae:.4f} | {detail:.2f} | {seam:.2f} |",
-                          flush=True)
+                    table.row(*label, f"{seconds:.2f}", f"{structure:.2f}", f"{mae:.4f}", f"{detail:.2f}",
+                              f"{seam:.2f}")
 
-    print()
-    print("Mean over the textures:")
-    print()
-    print("| case | method | hole | s | structure | MAE | detail | seam |")
-    print("|---|---|---|---|---|---|---|---|")
+    means = Table(("case", "method", "hole", "s", "structure", "MAE", "detail", "seam"),
+                  title="Mean over the textures:")
     for case in dict.fromkeys(r[0] for r in rows):
         for name in dict.fromkeys(r[1] for r in rows):
             for size in sizes:
                 sel = np.array([r[3:] for r in rows if r[:3] == (case, name, size)])
                 if len(sel):
                     s, structure, mae, detail, seam = sel.mean(axis=0)
-                    print(f"| {case} | {name} | {size} | {s:.2f} | {structure:.2f} | {mae:.4f} | {detail:.2f} "
-                          f"| {seam:.2f} |")
+                    means.row(case, name, size, f"{s:.2f}", f"{structure:.2f}", f"{mae:.4f}", f"{detail:.2f}",
+                              f"{seam:.2f}")
+    write(table, means)
 
 
 if __name__ == "__main__":

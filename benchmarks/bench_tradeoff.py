@@ -8,9 +8,10 @@ ratio of truth to input), the hidden region's scores, and the seconds of the lig
 of the synthesis, the CPU seconds of the process (steadier than the wall clock on a shared
 machine) and its peak resident memory during the removal (Linux only; Blender and the loaded
 scene included). The panorama resolution is swept on the 0.5 m box (256x128 and 1024x512).
-It writes `out/tradeoff/tradeoff.csv` and `tradeoff.md` (a row per setting, means over the
-scenes, the Pareto front of error against total seconds marked; `tradeoff_scenes.csv` has a row
-per scene and setting) and prints the Markdown;
+It writes `out/tradeoff/tradeoff.csv` and prints its table, also written into
+docs/results/bench_tradeoff.md (a row per setting, means over the scenes, the Pareto front of
+error against total seconds marked; `out/tradeoff/tradeoff_scenes.csv` has a row per scene and
+setting);
 `benchmarks/plot_tradeoff.py` draws the plot from the CSV.
 
 `--settings` picks the sweep's settings: labels of SETTINGS or `PRESET[+NAME=VALUE...]`
@@ -30,6 +31,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from rendered import arguments, open_scene
+from results import Table, write
 from scenes import metrics
 
 SCENES = ("basic_box", "red_box", "wall_contact", "stool")
@@ -148,17 +150,16 @@ def pareto(rows: list[dict], *, cost: str = "total_s", error: str = "lighting_ra
                                 and (o[cost] < row[cost] or o[error] < row[error]) for o in rows)
 
 
-def markdown(rows: list[dict]) -> str:
-    head = ("| setting | scenes | width | lighting error ratio | noise floor | ratio / floor | hidden mean "
-            "| hidden detail | object + shadow | lighting s | synthesis s | total s | CPU s | peak GB | Pareto |")
-    lines = [head, "|---" * 15 + "|"]
+def table(rows: list[dict], title: str) -> Table:
+    table = Table(("setting", "scenes", "width", "lighting error ratio", "noise floor", "ratio / floor", "hidden mean",
+                   "hidden detail", "object + shadow", "lighting s", "synthesis s", "total s", "CPU s", "peak GB",
+                   "Pareto"), title=title)
     for r in rows:
-        lines.append(f"| {r['setting']} | {r['scenes']} | {r['width']} | {r['lighting_ratio']:.3f} | "
-                     f"{r['noise_floor']:.3f} | {r['ratio_over_floor']:.2f} | {r['hidden_mean']:.3f} | "
-                     f"{r['hidden_detail']:.2f} | {r['object_shadow']:.3f} | {r['lighting_s']:.2f} | "
-                     f"{r['synthesis_s']:.2f} | {r['total_s']:.2f} | {r['cpu_s']:.2f} | {r['peak_gb']:.2f} | "
-                     f"{'yes' if r['pareto'] else ''} |")
-    return "\n".join(lines)
+        table.row(r["setting"], r["scenes"], r["width"], f"{r['lighting_ratio']:.3f}", f"{r['noise_floor']:.3f}",
+                  f"{r['ratio_over_floor']:.2f}", f"{r['hidden_mean']:.3f}", f"{r['hidden_detail']:.2f}",
+                  f"{r['object_shadow']:.3f}", f"{r['lighting_s']:.2f}", f"{r['synthesis_s']:.2f}",
+                  f"{r['total_s']:.2f}", f"{r['cpu_s']:.2f}", f"{r['peak_gb']:.2f}", "yes" if r["pareto"] else "")
+    return table
 
 
 def _write_csv(path: Path, rows: list[dict]) -> None:
@@ -182,8 +183,8 @@ def main() -> None:
     rows: list[dict] = []
     for name in filter(None, args.scenes.split(",")):
         rows += _measure(name, 256, 64, [setting(t) for t in args.settings.split(",")])
-    table = _mean_rows(rows, 256)
-    pareto(table)
+    table_rows = _mean_rows(rows, 256)
+    pareto(table_rows)
     wide = []
     for item in filter(None, args.wide.split(",")):
         name, _, samples = item.partition(":")
@@ -194,14 +195,11 @@ def main() -> None:
         row["pareto"] = False
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    _write_csv(out / "tradeoff.csv", table + wide)
+    _write_csv(out / "tradeoff.csv", table_rows + wide)
     _write_csv(out / "tradeoff_scenes.csv", rows + wide)
-    text = (f"Means over {args.scenes or 'no scenes'} at 256x128 (64 spp), then {args.wide or 'nothing'} at "
-            f"{args.width}x{args.width // 2} (SCENE:spp); "
-            f"{time.perf_counter() - started:.0f} s in all.\n\n" + markdown(table + wide) + "\n")
-    (out / "tradeoff.md").write_text(text)
-    print(text)
-
+    write(table(table_rows + wide, f"Means over {args.scenes or 'no scenes'} at 256x128 (64 spp), then "
+                                   f"{args.wide or 'nothing'} at {args.width}x{args.width // 2} (SCENE:spp); "
+                                   f"{time.perf_counter() - started:.0f} s in all."))
 
 if __name__ == "__main__":
     main()

@@ -40,14 +40,6 @@ def open_scene(args: argparse.Namespace) -> tuple[scene_specs.SceneSpec, dict[st
 FLOOR_SCENES = "basic_box,wall_contact,far_dark_box,tile_stool,stool,warm_cylinder,demo,oak_chair,walnut_crate,far_pouf"
 
 
-def print_table_header(title: str, columns: list[str]) -> None:
-    """A markdown table's title line, a blank line, its header and its rule."""
-    print(title)
-    print()
-    print("| " + " | ".join(columns) + " |")
-    print("|" + "---|" * len(columns), flush=True)
-
-
 def scene_list_arguments(description: str, scenes: str) -> argparse.Namespace:
     """Parsed --scenes (comma-separated, default `scenes`), --width (height = width / 2) and
     --samples (the demo gets at least 32)."""
