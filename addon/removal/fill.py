@@ -14,6 +14,7 @@ from ..geometry.mesh import Geometry
 from ..geometry.planeraster import edge_direction
 from ..light.radiosity import LUMA, RHO_MAX
 from ..report import Report
+from ..synthesis.material import Material
 from ..synthesis.plane_fill import FillOptions, HiddenPlane, PanoramaMaps, PanoramaReflectance, fill_surface
 from ..synthesis.texture import SynthesisParams
 from .interpolation import interpolate
@@ -109,12 +110,24 @@ def fill_hidden(solution: Solution, revealed: Revealed, light: HiddenLight, rep:
         if not got.synthesised:
             rep.warn(f"too little of '{name}' is seen around the object to synthesise its texture: "
                      f"{len(sel)} pixels get its mean reflectance")
+        if got.synthesised and got.material is not None and got.material.mostly_other:
+            rep.warn(_material_warning(name, got.material))
         surfaces.append({"surface": name, "pixels": len(sel), "raster": list(got.raster_shape),
                          "cell": round(got.cell, 5), "known_cells": got.known_cells, "hole_cells": got.hole_cells,
                          "synthesised": got.synthesised, "structured_cells": got.structured,
+                         "exemplar": None if got.material is None else got.material.source,
+                         "exemplar_share": None if got.material is None else round(got.material.share, 3),
                          "seconds": round(seconds, 4)})
     rep.info["filled_surfaces"] = surfaces
     return change()
+
+
+def _material_warning(surface: str, material: Material) -> str:
+    if material.source == "whole surface":
+        return (f"nothing of '{surface}' seen around the object matches the material at its border: "
+                f"the fill draws on the whole surface, clutter included")
+    return (f"'{surface}' around the object is mostly another material than at its border (clutter, a rug): "
+            f"the fill draws only on the {material.share:.0%} that matches")
 
 
 def hidden_planes(geo: Geometry, keys: np.ndarray, tri: np.ndarray, points: np.ndarray

@@ -18,6 +18,7 @@ from ..geometry import latlong, planeraster
 from ..light.radiosity import LUMA
 from ..segmentation.masks import box_mean
 from .lines import sharpened_across
+from .material import Material, border_material
 from .plank_profile import PlankProfile, fold_profile
 from .structure import Filled, fill_structured
 from .texture import SynthesisParams
@@ -106,6 +107,7 @@ class SurfaceFill:
     hole_cells: int
     synthesised: bool  # False: too little of the surface is seen; its mean reflectance is used
     structured: int = 0  # hole cells composed from shifted copies (the rest: order-independent synthesis)
+    material: Material | None = None  # which seen cells served as exemplar
 
 
 def fill_surface(
@@ -138,26 +140,30 @@ def fill_surface(
             hole[np.clip(r + dr, 0, h - 1), np.clip(c + dc, 0, w - 1)] = True
     hole |= flags == planeraster.HIDDEN
     hole &= ~known
-    mean = values[known].mean(axis=0) if known.any() else np.zeros(3)
-    image = np.where(known[..., None], values, mean)
+    material = border_material(values, known, hole, min_cells=_MIN_KNOWN)
+    # Only the hole's own material is copied; other things seen beside the hole (the object's
+    # legs, a rug's edge) are repainted as context so that nothing continues them into it.
+    exemplar, to_fill = material.exemplar, hole | material.replaced
+    mean = values[exemplar].mean(axis=0) if exemplar.any() else np.zeros(3)
+    image = np.where(exemplar[..., None], values, mean)
     filled = None
-    if known.sum() >= _MIN_KNOWN:
+    if exemplar.sum() >= _MIN_KNOWN:
         on_level = None if progress is None else (
             lambda _level, preview: progress(planeraster.sample_raster(raster, preview, points)))
         try:
             footprint = _footprint(raster) if options.structure else None
-            filled = fill_structured(image, known, hole, options.synthesis, structure=options.structure,
+            filled = fill_structured(image, exemplar, to_fill, options.synthesis, structure=options.structure,
                                      footprint=footprint, seed=options.seed, progress=on_level, cancel=cancel)
         except DimredError:
             pass  # too little exemplar: the mean below is the honest fallback, reported by the caller
     if filled is None:
         rho = planeraster.sample_raster(raster, image, points)
     else:
-        rho = _filled_rho(filled, panorama, plane, raster, image, known)
+        rho = _filled_rho(filled, panorama, plane, raster, image, exemplar)
     structure = None if filled is None else filled.structure
     return SurfaceFill(rho=rho, raster_shape=raster.shape, cell=raster.cell, known_cells=int(known.sum()),
-                       hole_cells=int(hole.sum()), synthesised=filled is not None,
-                       structured=0 if structure is None else int(structure.covered.sum()))
+                       hole_cells=int(to_fill.sum()), synthesised=filled is not None,
+                       structured=0 if structure is None else int(structure.covered.sum()), material=material)
 
 
 def _sharpened_lines(filled: Filled) -> np.ndarray:

@@ -1,0 +1,102 @@
+"""Which of a surface's seen cells are of the material the hole lies in: the exemplar.
+
+A proxy's floor is whatever the artist modelled, but the photograph shows on it a rug, a desk's
+foot, the object's own legs and contact shadow. Copied into the hole they are the fill's worst
+failures (a dark bruise, a rug's stripes where there was wood), so the exemplar is restricted to
+the cells of the hole's own material.
+
+That material is what surrounds the hole on every side: a colour (log luminance and
+chromaticity over 3x3 cells) belongs to it when it occurs in most directions around the hole,
+at a distance from it. A checker's two colours, a plank floor's shades and seams, and the blends
+between them do; a rug, a bed or a desk's foot on one side does not, nor does the contact shadow
+or the legs right at the object. What is wider than a line and of no such colour is left out,
+with a cell of margin; beside the hole it is repainted, so that nothing continues it inward.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..light.radiosity import LUMA
+from ..segmentation.masks import box_mean, dilate, erode
+from .shift_map import hole_extent
+
+# Feature bins: log luminance in steps of 0.15, chromaticity (r, g) in steps of 0.03: about what
+# the eye calls another colour at a glance. A colour is near the bins within one step of its own.
+_STEPS = np.array([0.15, 0.03, 0.03])
+_SECTORS = 8  # directions around the hole
+_MIN_SECTOR_CELLS = 16  # cells a direction needs around the hole to count
+_PRESENT = 0.01  # share of a direction's cells a colour needs there (at least 2 cells)
+_AROUND = 0.75  # share of the counted directions a colour must be present in
+_MIN_SHARE_WARN = 0.5  # below this share of the seen cells, the surface is mostly something else
+
+
+@dataclass(frozen=True)
+class Material:
+    """The known cells of the hole's material (`exemplar`), the other known cells near the hole
+    that the fill repaints as context (`replaced`), and what the exemplar is: `source`
+    'border material' or, where too few cells match, 'whole surface'."""
+
+    exemplar: np.ndarray
+    replaced: np.ndarray
+    source: str
+    share: float  # exemplar cells / known cells
+
+    @property
+    def mostly_other(self) -> bool:
+        """Most of the surface seen around the hole is of another material (clutter, a rug)."""
+        return self.source != "border material" or self.share < _MIN_SHARE_WARN
+
+
+def border_material(image: np.ndarray, known: np.ndarray, hole: np.ndarray, *, min_cells: int) -> Material:
+    """The cells of `image` (h, w, 3 reflectance) among `known` whose material surrounds `hole`;
+    the whole of `known` where fewer than `min_cells` match."""
+    whole = Material(exemplar=known, replaced=np.zeros_like(known), source="whole surface", share=1.0)
+    if not hole.any():
+        return whole
+    reach = int(np.clip(round(hole_extent(hole) / 2), 4, 32))
+    near = dilate(hole, reach) & ~hole
+    # The ring's inner half holds the contact shadow and the legs: only its outer half decides.
+    around = known & near & ~dilate(hole, reach // 2)
+    if not around.any():
+        return whole
+    mean, _ = box_mean(np.concatenate([np.log(np.maximum(image @ LUMA, 1e-4))[..., None],
+                                       image[..., :2] / np.maximum(image.sum(axis=-1, keepdims=True), 1e-6)],
+                                      axis=-1), known, 1)
+    bins = np.floor(mean / _STEPS).astype(np.int64)
+    lo = bins[known].min(axis=0)
+    shape = tuple(bins[known].max(axis=0) - lo + 1)
+    flat = np.ravel_multi_index(tuple(np.moveaxis(np.clip(bins - lo, 0, np.array(shape) - 1), -1, 0)), shape)
+    rows, cols = np.nonzero(around)
+    hr, hc = (float(x.mean()) for x in np.nonzero(hole))
+    sector = ((np.arctan2(rows - hr, cols - hc) + np.pi) / (2 * np.pi) * _SECTORS).astype(np.int64) % _SECTORS
+    counts = np.zeros((int(np.prod(shape)), _SECTORS))
+    np.add.at(counts, (flat[rows, cols], sector), 1.0)
+    per_sector = counts.sum(axis=0)
+    counted = per_sector >= _MIN_SECTOR_CELLS
+    if not counted.any():
+        return whole
+    near_counts = _neighbour_sum(counts.reshape(*shape, _SECTORS))
+    present = near_counts.reshape(-1, _SECTORS) >= np.maximum(_PRESENT * per_sector, 2.0)
+    common = (present & counted).sum(axis=1) >= _AROUND * counted.sum()
+    matching = known & common[flat]
+    # Cells between a texture's colours (a tile's edge, a seam) may match nothing on their own:
+    # only what is wider than a line counts as something else, with a cell of margin around it.
+    other = dilate(dilate(erode(known & ~matching, 1), 1), 1) & known
+    exemplar = known & ~other
+    if exemplar.sum() < min_cells:
+        return whole
+    return Material(exemplar=exemplar, replaced=near & other, source="border material",
+                    share=float(exemplar.sum() / known.sum()))
+
+
+def _neighbour_sum(counts: np.ndarray) -> np.ndarray:
+    """`counts` (a, b, c, k) summed over the bins within one step along each of the first three axes."""
+    out = counts.copy()
+    for axis in range(3):
+        padded = np.pad(out, [(1, 1) if a == axis else (0, 0) for a in range(4)])
+        n = out.shape[axis]
+        out = (padded.take(range(n), axis=axis) + padded.take(range(1, n + 1), axis=axis)
+               + padded.take(range(2, n + 2), axis=axis))
+    return out
