@@ -29,6 +29,8 @@ REMOVALS = [(name, "balanced") for name in (
     "basic_box", "red_box", "stool", "wall_contact", "bright_lamp", "seam", "rotated_world", "second_object",
     "tiny_lamp", "dark_floor", "white_floor", "zenith", "grazing", "shadowed_box", "demo")]
 REMOVALS += [("nadir", "draft"), ("stool", "final"), ("red_box", "draft")]
+# Several objects removed in order, each from what the ones before left (the composition).
+COMPOSED = [("second_object", ("Box", "Cabinet"))]
 RELOCATIONS = [("basic_box", 40.0, 1.3), ("stool", 40.0, 1.3), ("rotated_world", -40.0, 1.3),
                ("wall_contact", -40.0, 1.3), ("red_box", 25.0, 0.8), ("second_object", -40.0, 1.3),
                ("bright_lamp", 40.0, 1.3), ("seam", 40.0, 1.3), ("nadir", 40.0, 1.3), ("shadowed_box", 60.0, 1.2)]
@@ -41,6 +43,10 @@ def _cases() -> list[tuple[str, list[str]]]:
         blend = str(render_pair(spec)["blend"])
         cases.append((f"remove-{name}-{quality}",
                       ["remove", blend, "--object", spec.remove, "--quality", quality]))
+    for name, objects in COMPOSED:
+        blend = str(render_pair(scene_specs.get(name))["blend"])
+        cases.append((f"remove-{name}-{'-'.join(objects)}",
+                      ["remove", blend, *(a for o in objects for a in ("--object", o))]))
     for name, yaw, scale in RELOCATIONS:
         spec = scene_specs.get(name)
         blend = str(render_pair(spec)["blend"])
