@@ -115,7 +115,7 @@ def _build(args: argparse.Namespace) -> None:
     import bpy
 
     from addon.blender import reader
-    from addon.blender.cli import open_blend
+    from addon.blender.blend_file import open_blend
     from scenes.images import write_exr
 
     open_blend(str(args.blend))

@@ -30,7 +30,7 @@ def open_scene(args: argparse.Namespace) -> tuple[scene_specs.SceneSpec, dict[st
     """Render the pair unless cached, open its .blend in Blender; (spec, paths of the pair)."""
     spec = scene_specs.get(args.scene).with_render(width=args.width, height=args.width // 2, samples=args.samples)
     paths = render_pair(spec)
-    from addon.blender.cli import open_blend  # bpy only after rendering, which runs in a subprocess
+    from addon.blender.blend_file import open_blend  # bpy only after rendering, which runs in a subprocess
 
     open_blend(str(paths["blend"]))
     return spec, paths

@@ -123,7 +123,7 @@ def _inspect(args: argparse.Namespace) -> int:
     import bpy
 
     from . import reader
-    from .cli import open_blend
+    from .blend_file import open_blend
 
     for blend in args.blends:
         path = os.path.abspath(blend)

@@ -12,21 +12,11 @@ Bad input gets one line `dimred: error: ...` on stderr, exit code 2, and nothing
 from __future__ import annotations
 
 import argparse
-import contextlib
-import ctypes
-import io
-import json
 import os
-import shutil
 import sys
-import tempfile
 import time
-from collections.abc import Callable, Iterator, Sequence
-from concurrent.futures import ThreadPoolExecutor
-from dataclasses import replace
+from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING
-
-import numpy as np
 
 from .. import memory
 from ..callbacks import RunCallbacks
@@ -37,7 +27,6 @@ from . import batch_cli
 if TYPE_CHECKING:
     from ..removal import RemovalResult
     from ..scene import SceneData
-    from ..segmentation.seen import SeenObject
 
 PROG = "dimred"
 #: Exit status for bad input (the same as argparse's usage errors).
@@ -235,48 +224,13 @@ def _overrides(args: argparse.Namespace) -> dict[str, int]:
 
 def _remove(args: argparse.Namespace) -> int:
     from .. import pipeline
+    from ..composition import remove_in_order
 
-    def remove(scene: SceneData, name: str, **options) -> RemovalResult:
-        return pipeline.remove_object(scene, name, align=args.align, fit_height=args.fit_height, **options)
+    def compute(scene: SceneData, **options) -> RemovalResult:
+        return remove_in_order(scene, args.objects, lambda step, name: pipeline.remove_object(
+            step, name, align=args.align, fit_height=args.fit_height, **options))
 
-    return _run(args, "removed", lambda scene, **options: _in_order(args, scene, remove, **options))
-
-
-def _in_order(args: argparse.Namespace, scene_data: SceneData, remove: Callable[..., RemovalResult],
-              **options) -> RemovalResult:
-    """The objects removed one after the other, as the panel composes removals: each from the
-    panorama plus the differences before it, with the objects removed before gone from the room.
-    The result is the sum of the differences; the report holds each removal's under "removals"."""
-    import bpy
-
-    from ..removal import RemovalResult
-    from . import reader
-
-    first, *rest = args.objects
-    result = remove(scene_data, first, **options)
-    if not rest:
-        return result
-    original, total, hidden = scene_data.hdri, result.difference, result.hidden_mask.copy()
-    reports = [result.report]
-    for count, name in enumerate(rest, start=1):
-        later = reader.read_scene(bpy.context.scene, center=args.center, exclude=args.objects[:count], defer_file=True)
-        later = replace(later, hdri=original + total)
-        step = remove(later, name, **options)
-        total += step.difference
-        hidden |= step.hidden_mask
-        reports.append(step.report)
-        del later, step
-    seconds: dict[str, float] = {}
-    for report in reports:
-        for stage, value in report.get("seconds", {}).items():
-            seconds[stage] = round(seconds.get(stage, 0.0) + value, 4)
-    report = {"objects": list(args.objects), "removals": reports, "seconds": seconds,
-              "image_size": reports[0].get("image_size"),
-              "hidden_pixels": sum(r.get("hidden_pixels", 0) for r in reports),
-              "hidden_region_filled": all(r.get("hidden_region_filled", True) for r in reports),
-              "warnings": [f"{n}: {w}" for n, r in zip(args.objects, reports, strict=True)
-                           for w in r.get("warnings", [])]}
-    return RemovalResult(difference=total, hidden_mask=hidden, report=report, hdri=original, seen=result.seen)
+    return _run(args, "removed", compute)
 
 
 def _relocate(args: argparse.Namespace) -> int:
@@ -302,6 +256,8 @@ def _align(args: argparse.Namespace) -> int:
 
     from .. import pipeline
     from ..io.exr import write_png
+    from ..io.outputs import json_writer, write_files
+    from ..segmentation.diagnostics import picture_of
 
     started = time.perf_counter()
     out = _output_folder(args.out)
@@ -316,8 +272,8 @@ def _align(args: argparse.Namespace) -> int:
     report = {"alignment": alignment.summary(), "segmentation": seen.summary() if seen else None,
               "seconds": {"alignment": round(alignment.seconds, 4),
                           "total": round(time.perf_counter() - started, 4)}}
-    picture = None if seen is None else diagnostics_image(seen)
-    _write_files(out, {"report.json": _json_writer(report)}
+    picture = None if seen is None else picture_of(seen)
+    write_files(out, {"report.json": json_writer(report)}
                  | ({} if picture is None else {"diagnostics.png": lambda path: write_png(path, picture)}),
                  stale=("diagnostics.png",))
     if not alignment.applied and not alignment.fits:
@@ -334,7 +290,9 @@ def _align(args: argparse.Namespace) -> int:
     return 0
 
 
-def _run(args: argparse.Namespace, done: str, compute: Callable[..., object]) -> int:
+def _run(args: argparse.Namespace, done: str, compute: Callable[..., RemovalResult]) -> int:
+    from ..io.outputs import write_outputs
+
     started = time.perf_counter()
     out = _output_folder(args.out)
     scene_data = _read(args)
@@ -378,6 +336,7 @@ def _read(args: argparse.Namespace) -> SceneData:
     import bpy
 
     from . import reader
+    from .blend_file import open_blend
 
     if args.blend is not None:
         open_blend(args.blend)
@@ -404,153 +363,5 @@ def _read(args: argparse.Namespace) -> SceneData:
     return scene_data
 
 
-def open_blend(path: str) -> None:
-    """Open a .blend file as the current Blender session; DimredError if it cannot be read."""
-    import bpy
-
-    path = os.path.abspath(path)
-    if not os.path.isfile(path):
-        raise DimredError(f"no such .blend file: {path}")
-    with _captured_stdout() as captured:
-        try:
-            bpy.ops.wm.open_mainfile(filepath=path, load_ui=False)
-        except RuntimeError as error:
-            reason = str(error).strip().removeprefix("Error:").strip() or captured().strip()
-            raise DimredError(f"cannot open {path}: {reason}") from None
-
-
-def write_outputs(out: str, result: RemovalResult, report: dict) -> None:
-    """Write the result files into `out`, all or nothing (see `_write_files`). The edited
-    panorama is written a band of rows at a time (it never exists whole) and refused at the
-    first band with a non-finite value; the difference is checked first."""
-    from ..io.exr import write_exr, write_exr_rows, write_png
-    from ..radiance import non_finite_pixels
-
-    height, width = result.difference.shape[:2]
-    mask = result.hidden_mask if report.get("hidden_region_filled") is False else None
-
-    def images(staging: str) -> None:
-        if non_finite_pixels(result.difference):
-            raise DimredError("the removal produced non-finite values in difference.exr; nothing was written")
-        # The whole-image writer lets go of the interpreter lock while it compresses, so the
-        # difference is written on a second core beside the edited panorama's bands.
-        with ThreadPoolExecutor(max_workers=1) as pool:
-            difference = pool.submit(write_exr, os.path.join(staging, "difference.exr"), result.difference)
-            edited = _finite("edited.exr", result.edited_rows)
-            write_exr_rows(os.path.join(staging, "edited.exr"), height, width, edited)
-            difference.result()
-
-    writers: dict[str, Callable[[str], None]] = {"": images, "report.json": _json_writer(report)}
-    if mask is not None:
-        writers["hidden_mask.png"] = lambda path: write_png(path, np.where(mask, 255, 0).astype(np.uint8))
-    if result.seen is not None:
-        writers["diagnostics.png"] = lambda path: write_png(path, diagnostics_image(result.seen))
-    # A mask or picture left from an earlier run would describe another result.
-    _write_files(out, writers, stale=("hidden_mask.png", "diagnostics.png"))
-
-
-def diagnostics_image(seen: SeenObject) -> np.ndarray:
-    """The diagnostics picture of the object as the photograph showed it (uint8 RGB)."""
-    from ..segmentation.diagnostics import diagnostics_picture
-
-    outline = seen.segmentation.object if seen.segmentation is not None else seen.shown
-    return diagnostics_picture(seen.image, seen.proxy, outline)
-
-
-def _json_writer(report: dict) -> Callable[[str], None]:
-    """A writer of `report` as JSON, refused (before anything touches the disk) when it is not."""
-    try:
-        payload = json.dumps(report, indent=2, allow_nan=False)
-    except (TypeError, ValueError) as error:
-        raise DimredError(f"the report cannot be written as JSON ({error}); nothing was written") from None
-
-    def write(path: str) -> None:
-        with open(path, "w", encoding="utf-8") as handle:
-            handle.write(payload + "\n")
-
-    return write
-
-
-def _write_files(out: str, writers: dict[str, Callable[[str], None]], *, stale: Sequence[str] = ()) -> None:
-    """Write files into `out`, all or nothing: each writer gets its path in a hidden staging
-    folder (the writer of "" gets the folder itself, for several files), made inside `out` when
-    it exists, else in its deepest existing parent, so the final renames stay on one file
-    system; they are moved in only when all are complete, and files in `stale` that this run
-    did not write are removed then. A failure leaves `out` and earlier results as they were."""
-    try:
-        staging = tempfile.mkdtemp(prefix=".dimred-", dir=_existing_folder(out))
-    except OSError as error:
-        raise DimredError(f"cannot write into {out}: {error.strerror or error}") from None
-    try:
-        for name, writer in writers.items():
-            writer(os.path.join(staging, name) if name else staging)
-        os.makedirs(out, exist_ok=True)
-        written = set(os.listdir(staging))
-        for name in stale:
-            if name not in written:
-                with contextlib.suppress(FileNotFoundError):
-                    os.unlink(os.path.join(out, name))
-        for name in written:
-            os.replace(os.path.join(staging, name), os.path.join(out, name))
-    except OSError as error:
-        raise DimredError(f"cannot write into {out}: {error.strerror or error}") from None
-    finally:
-        shutil.rmtree(staging, ignore_errors=True)
-
-
-def _finite(name: str, rows: Callable[[int, int], np.ndarray]) -> Callable[[int, int], np.ndarray]:
-    """`rows`, refusing a band with a NaN or infinite value (the staged files are then dropped)."""
-
-    def checked(start: int, stop: int) -> np.ndarray:
-        band = rows(start, stop)
-        if not np.isfinite(band).all():
-            raise DimredError(f"the removal produced non-finite values in {name}; nothing was written")
-        return band
-
-    return checked
-
-
-def _existing_folder(path: str) -> str:
-    """`path` if it is a folder, else the deepest existing folder above it."""
-    folder = path
-    while not os.path.isdir(folder):
-        folder = os.path.dirname(folder)
-    return folder
-
-
 def _print_progress(stage: str, fraction: float) -> None:
     print(f"{PROG}: {100.0 * fraction:5.1f}% {stage}", file=sys.stderr, flush=True)
-
-
-@contextlib.contextmanager
-def _captured_stdout() -> Iterator[Callable[[], str]]:
-    """Keep Blender's own reports off our stdout while loading: Blender prints them through
-    Python's sys.stdout and through C's buffered stdout (file descriptor 1)."""
-    sys.stdout.flush()
-    _flush_c_stdio()
-    python_level = io.StringIO()
-    with tempfile.TemporaryFile(mode="w+b") as sink:
-        saved = os.dup(1)
-        os.dup2(sink.fileno(), 1)
-
-        def text() -> str:
-            _flush_c_stdio()
-            sink.seek(0)
-            return sink.read().decode("utf-8", "replace") + python_level.getvalue()
-
-        try:
-            with contextlib.redirect_stdout(python_level):
-                yield text
-        finally:
-            _flush_c_stdio()
-            os.dup2(saved, 1)
-            os.close(saved)
-
-
-def _flush_c_stdio() -> None:
-    try:
-        ctypes.CDLL(None).fflush(None)
-    except (OSError, AttributeError, TypeError):
-        # No C runtime reachable this way (Windows): its output may then reach the terminal.
-        pass
-

@@ -6,8 +6,9 @@ thread or, in background mode, directly. A request with a `move` relocates the o
 at the photographed place, insertion at the moved one) and is otherwise handled the same; the
 artist's mask and Align to Photo (`align`, `fit_height`) go to the engine as they are, and the
 outcome keeps the object as the photograph showed it, for the diagnostics picture.
-Removals compose: the request names the differences of the objects removed before (`base`),
-the engine works on HDRI + base, and the world layer shows base + this run's difference. Files
+Removals compose (`addon.composition`): the request names the objects removed before
+(`removed`) and their differences (`base`); the engine works on HDRI + base without those
+objects, and the world layer shows base + this run's difference. Files
 are written under temporary names next to their final paths and only `Staged.commit` (on the
 main thread, once the run is accepted) renames them into place, so a cancelled or failed run
 leaves earlier results as they were.
@@ -23,12 +24,13 @@ import functools
 import os
 import secrets
 import shutil
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from ..callbacks import NO_CALLBACKS, RunCallbacks
+from ..composition import on_earlier
 from ..errors import DimredError
 from ..geometry.mesh import to_probe_frame
 from ..io.exr import read_exr, write_exr
@@ -50,7 +52,8 @@ class RemovalRequest:
     object_name: str
     planes: tuple[str, ...] = ()
     quality: str = DEFAULT_QUALITY
-    base: tuple[Layer, ...] = ()  # the own differences of the objects removed before
+    base: tuple[Layer, ...] = ()  # the own differences of the objects removed (or relocated) before
+    removed: tuple[str, ...] = ()  # the objects removed before, left out of the geometry
     previous: Layer | None = None  # this object's own difference from a run before (the world shows it)
     own_path: str = ""  # where this removal's own difference goes
     layer_path: str = ""  # where base + own difference (what the world shows) goes
@@ -181,26 +184,29 @@ def _small_input(panorama: small_copy.SmallCopy, base: list[small_copy.SmallCopy
 
 def _engine_input(request: RemovalRequest, callbacks: RunCallbacks, panorama: small_copy.SmallCopy | None,
                   base: list[small_copy.SmallCopy | None], *, small: bool) -> tuple[SceneData, np.ndarray | None]:
-    """The scene with its panorama read and the earlier results added to it, and, if `small`,
-    the small copy of that (from the small copies at hand where there are)."""
+    """The scene composed with the earlier results (`composition.on_earlier`: read, their
+    differences added to the panorama, their objects left out) and, if `small`, the small copy
+    of that panorama (from the small copies at hand where there are)."""
     scene = loaded(request.scene)
-    hdri = scene.hdri
     if small and panorama is None:
-        panorama = small_copy.of_image(hdri)
+        panorama = small_copy.of_image(scene.hdri)
         if request.cache_folder:
             small_copy.store(scene.hdri_path, panorama, request.cache_folder)
     callbacks.check()
     copies = []
-    for layer, copy in zip(request.base, base, strict=True):
-        image = _pixels(layer, hdri.shape)
-        if hdri is request.scene.hdri:
-            hdri = hdri.astype(np.float32)  # a copy: the caller's array stays as it was
-        hdri += image
-        if small:
-            copies.append(copy or small_copy.of_image(image))
-        del image
-        callbacks.check()
-    return replace(scene, hdri=hdri), _small_input(panorama, copies) if small else None
+
+    def earlier() -> Iterator[np.ndarray]:
+        for layer, copy in zip(request.base, base, strict=True):
+            image = _pixels(layer, scene.hdri.shape)
+            if small:
+                copies.append(copy or small_copy.of_image(image))
+            yield image
+            del image
+            callbacks.check()
+
+    # A panorama read here is this run's own: the differences are added into it, not a copy.
+    composed = on_earlier(scene, earlier(), request.removed, own=request.scene.hdri is None)
+    return composed, _small_input(panorama, copies) if small else None
 
 
 def _pixels(layer: Layer, shape: tuple[int, ...]) -> np.ndarray:

@@ -6,9 +6,14 @@ cyan line the proxy's outline and a yellow one the segmented outline.
 """
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from .masks import outline
+
+if TYPE_CHECKING:
+    from .seen import SeenObject
 
 _LUMINANCE = np.array([0.2126, 0.7152, 0.0722], dtype=np.float32)
 _MISSED = np.array([1.0, 0.15, 0.1], dtype=np.float32)  # red: object outside the proxy
@@ -16,6 +21,14 @@ _EXCESS = np.array([0.15, 0.35, 1.0], dtype=np.float32)  # blue: proxy over back
 _PROXY_LINE = np.array([0.0, 1.0, 1.0], dtype=np.float32)  # cyan
 _OBJECT_LINE = np.array([1.0, 1.0, 0.0], dtype=np.float32)  # yellow
 _TINT = 0.45  # share of the tint colour over the picture
+
+
+def picture_of(seen: SeenObject) -> np.ndarray:
+    """The diagnostics picture of the object as the photograph showed it (uint8 RGB): its window
+    with the proxy and the segmented outline marked (the object as shown where no segmentation
+    ran)."""
+    segmented = seen.segmentation.object if seen.segmentation is not None else seen.shown
+    return diagnostics_picture(seen.image, seen.proxy, segmented)
 
 
 def diagnostics_picture(image: np.ndarray, proxy: np.ndarray, segmented: np.ndarray, *,

@@ -43,9 +43,9 @@ class Picture:
 
 def diagnostics_picture(seen: SeenObject | None) -> Picture | None:
     """The diagnostics picture of the object as the photograph showed it (None: it did not)."""
-    from ...addon.blender.cli import diagnostics_image
+    from ...addon.segmentation.diagnostics import picture_of
 
-    return None if seen is None else Picture.of(diagnostics_image(seen))
+    return None if seen is None else Picture.of(picture_of(seen))
 
 
 def show_diagnostics(picture: Picture) -> bpy.types.Image:

@@ -107,18 +107,30 @@ def _earlier(settings: bpy.types.PropertyGroup, target: str) -> list:
 
 def engine_scene(scene: bpy.types.Scene, target: str, photographed: Matrix | None = None) -> SceneData:
     """The scene as the engine must see it for a run on `target`: earlier removed objects gone
-    from the room, relocated ones at their new place, and `target` where the panorama shows it
-    (`photographed`, by default `photographed_matrix`: also when an earlier relocation of it
-    has moved it since); the panorama's pixels deferred."""
+    from the room (`composition.without_objects`), relocated ones at their new place, and
+    `target` where the panorama shows it; the panorama's pixels deferred."""
+    from ...addon.composition import without_objects
+
+    return without_objects(_photographed_scene(scene, target, photographed), _removed_before(scene.dimred, target))
+
+
+def _photographed_scene(scene: bpy.types.Scene, target: str, photographed: Matrix | None = None) -> SceneData:
+    """The whole room with `target` where the panorama shows it (`photographed`, by default
+    `photographed_matrix`: also when an earlier relocation of it has moved it since), relocated
+    objects at their new place; the panorama's pixels deferred."""
     from ...addon.blender import reader
 
     settings = scene.dimred
-    removed = [r.object_name for r in _earlier(settings, target) if r.kind == 'REMOVE']
-    scene_data = reader.read_scene(scene, center=probe_center(settings), defer_file=True, exclude=removed)
+    scene_data = reader.read_scene(scene, center=probe_center(settings), defer_file=True)
     obj = scene.objects[target]
     if photographed is None:
         photographed = photographed_matrix(settings, obj)
     return _placed(scene_data, target, to_photographed(obj, photographed))
+
+
+def _removed_before(settings: bpy.types.PropertyGroup, target: str) -> list[str]:
+    """The objects removed (not relocated) before a run on `target`."""
+    return [r.object_name for r in _earlier(settings, target) if r.kind == 'REMOVE']
 
 
 def active() -> RemovalSession | None:
@@ -220,13 +232,15 @@ class RemovalSession:
                 reader.check_object(scene, name, purpose="used as a target surface")
             if photographed is None:
                 photographed = photographed_matrix(settings, scene.objects[target])
-            scene_data = engine_scene(scene, target, photographed)
-            # Their shapes are checked against the panorama's in the worker, where it is read.
+            # The worker composes this run with the earlier ones (`addon.composition.on_earlier`):
+            # their objects leave the geometry, their differences are added to the panorama,
+            # whose shapes are checked against the panorama's there, where it is read.
             base = tuple(_layer_source(r.image, os.path.join(scratch, f"earlier_{i}.exr"))
                          for i, r in enumerate(earlier))
             previous = _layer_source(own, os.path.join(scratch, "previous.exr")) if own is not None else None
             request = RemovalRequest(
-                scene=scene_data, object_name=target, planes=names, quality=settings.quality, base=base,
+                scene=_photographed_scene(scene, target, photographed), object_name=target, planes=names,
+                quality=settings.quality, base=base, removed=tuple(_removed_before(settings, target)),
                 own_path=os.path.join(folder, own_filename(world, target)),
                 layer_path=os.path.join(folder, layer_filename(world)), overrides=settings.overrides(), move=move,
                 previous=previous, cache_folder=warmup.folder(), mask=mask, align=settings.align_first,
