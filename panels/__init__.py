@@ -1,9 +1,9 @@
 """The 3D Viewport sidebar tab "Diminished Reality"."""
 from __future__ import annotations
 
-from . import sidebar
+from . import room, sidebar
 
-_modules = (sidebar,)
+_modules = (sidebar, room)
 
 
 def register() -> None:

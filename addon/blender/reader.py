@@ -94,6 +94,11 @@ def panorama_size(scene: bpy.types.Scene) -> tuple[int, int]:
     return _loaded_size(image, path)
 
 
+def panorama_pixels(scene: bpy.types.Scene) -> np.ndarray:
+    """The panorama's (H, W, 3) float32 linear RGB, top row first, as `read_scene` reads it."""
+    return _panorama(environment_texture(scene).image, [])[0]
+
+
 def panorama_file(scene: bpy.types.Scene) -> str:
     """The file the panorama is read from; "" when its pixels are in the .blend (packed or
     generated): what a batch hashes besides the .blend to tell whether a job's input changed."""

@@ -48,11 +48,11 @@ def diagnostics_picture(seen: SeenObject | None) -> Picture | None:
     return None if seen is None else Picture.of(picture_of(seen))
 
 
-def show_diagnostics(picture: Picture) -> bpy.types.Image:
-    """Put `picture` into the image "Dimred Diagnostics" (made, or resized, as needed)."""
-    image = bpy.data.images.get(DIAGNOSTICS_IMAGE)
+def show_diagnostics(picture: Picture, name: str = DIAGNOSTICS_IMAGE) -> bpy.types.Image:
+    """Put `picture` into the image `name` (made, or resized, as needed)."""
+    image = bpy.data.images.get(name)
     if image is None:
-        image = bpy.data.images.new(DIAGNOSTICS_IMAGE, *picture.size, alpha=False)
+        image = bpy.data.images.new(name, *picture.size, alpha=False)
     elif tuple(image.size) != picture.size:
         image.scale(*picture.size)
     image.pixels.foreach_set(picture.pixels)

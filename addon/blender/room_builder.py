@@ -1,0 +1,114 @@
+"""Match Room in Blender: the fitted room as the mesh objects Floor, Walls and Ceiling, the probe
+centre where the camera was, and the clicks kept on the scene.
+
+Objects of those names are reused (their materials kept, their meshes replaced), so a re-fit
+after a moved click updates the room in place. Nothing is changed when the clicks show no room:
+every check runs before the first object is touched.
+"""
+from __future__ import annotations
+
+import bpy
+import numpy as np
+
+from ..errors import DimredError
+from ..roommatch import clicks as click_file
+from ..roommatch.clicks import RoomClicks
+from ..roommatch.fit import DEFAULT_CEILING_HEIGHT, RoomFit, fit_room
+from ..roommatch.meshes import NAMES, MeshData, room_meshes
+from . import reader
+
+#: The scene's custom property holding the last matched room's click file (JSON).
+CLICKS_PROPERTY = "dimred_room_clicks"
+
+
+def panorama_rotation(scene: bpy.types.Scene) -> np.ndarray:
+    """The world's Mapping rotation, the identity where the scene has no panorama yet."""
+    try:
+        return reader.texture_rotation(reader.environment_texture(scene))
+    except DimredError:
+        return np.eye(3)
+
+
+def match_room(scene: bpy.types.Scene, clicks: RoomClicks, *,
+               ceiling_height: float = DEFAULT_CEILING_HEIGHT) -> RoomFit:
+    """Fit the room the clicks show and build it in `scene`; DimredError and nothing changed when
+    the clicks show none or an object in the way is not a mesh."""
+    rotation = panorama_rotation(scene)
+    origin = tuple(scene.objects[reader.PROBE_OBJECT_NAME].location[:2]) \
+        if reader.PROBE_OBJECT_NAME in scene.objects else (0.0, 0.0)
+    room = fit_room(clicks, rotation=rotation, origin=origin, ceiling_height=ceiling_height)
+    for name in NAMES:
+        obj = bpy.data.objects.get(name)
+        if obj is not None and obj.type != 'MESH':
+            raise DimredError(f"an object named '{name}' exists and is a {obj.type}, not a mesh: rename it first")
+    for mesh in room_meshes(room):
+        _put_mesh(scene, mesh)
+    set_probe_center(scene, room.probe)
+    scene[CLICKS_PROPERTY] = clicks.to_json()
+    return room
+
+
+def stored_clicks(scene: bpy.types.Scene) -> RoomClicks | None:
+    """The clicks of the room last matched in `scene`, or None."""
+    text = scene.get(CLICKS_PROPERTY)
+    return None if text is None else click_file.from_json(str(text))
+
+
+def set_probe_center(scene: bpy.types.Scene, location: np.ndarray) -> None:
+    """Move the probe centre to `location`: the ProbeCenter Empty, and the add-on's setting or the
+    scene's probe_center property where the scene uses one."""
+    probe = scene.objects.get(reader.PROBE_OBJECT_NAME)
+    if probe is None:
+        probe = bpy.data.objects.new(reader.PROBE_OBJECT_NAME, None)
+        probe.empty_display_type = 'SPHERE'
+        probe.empty_display_size = 0.1
+        scene.collection.objects.link(probe)
+    probe.location = tuple(location)
+    settings = getattr(scene, "dimred", None)
+    if settings is not None and hasattr(settings, "probe_center"):
+        settings.probe_center = tuple(location)
+        settings.use_probe_center = True
+    elif scene.get("probe_center") is not None:
+        scene["probe_center"] = [float(v) for v in location]
+
+
+def show_panorama(scene: bpy.types.Scene, path: str) -> None:
+    """Make the scene's world show the HDR panorama at `path` (a new world, no Mapping node)."""
+    try:
+        image = bpy.data.images.load(path, check_existing=True)
+    except RuntimeError as error:
+        raise DimredError(f"cannot load the panorama '{path}': {error}") from None
+    world = bpy.data.worlds.new("Panorama")
+    if world.node_tree is None:
+        world.use_nodes = True  # Blender 4.x creates worlds without a node tree
+    tree = world.node_tree
+    tree.nodes.clear()
+    environment = tree.nodes.new("ShaderNodeTexEnvironment")
+    environment.image = image
+    background = tree.nodes.new("ShaderNodeBackground")
+    output = tree.nodes.new("ShaderNodeOutputWorld")
+    tree.links.new(environment.outputs["Color"], background.inputs["Color"])
+    tree.links.new(background.outputs["Background"], output.inputs["Surface"])
+    scene.world = world
+
+
+def _put_mesh(scene: bpy.types.Scene, data: MeshData) -> bpy.types.Object:
+    mesh = bpy.data.meshes.new(data.name)
+    mesh.from_pydata([tuple(v) for v in data.vertices.tolist()], [], [list(f) for f in data.faces])
+    mesh.validate()
+    obj = bpy.data.objects.get(data.name)
+    if obj is None:
+        obj = bpy.data.objects.new(data.name, mesh)
+        scene.collection.objects.link(obj)
+    else:
+        old = obj.data
+        for material in old.materials:
+            mesh.materials.append(material)
+        obj.data = mesh
+        obj.matrix_world.identity()
+        if old.users == 0:
+            bpy.data.meshes.remove(old)
+        mesh.name = data.name
+        if obj.name not in scene.objects:
+            scene.collection.objects.link(obj)
+    return obj

@@ -1,0 +1,59 @@
+"""room_diagnostics.png: the whole panorama with every edge of the matched room drawn over it.
+
+Floor edges green, ceiling edges magenta, the walls' vertical corners cyan, each curve where it
+reprojects in lat-long; the clicks as yellow crosses. A wall in the wrong place shows as a line
+beside the photograph's.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..geometry.resample import resample_axis
+from ..segmentation.diagnostics import _srgb, _tone_map
+from .clicks import RoomClicks
+from .fit import RoomFit
+from .meshes import room_edges
+from .projection import project
+
+_COLOURS = np.array([[0.1, 1.0, 0.2], [1.0, 0.2, 1.0], [0.0, 1.0, 1.0]], dtype=np.float32)  # floor, ceiling, corner
+_CLICK = np.array([1.0, 0.9, 0.0], dtype=np.float32)
+_SAMPLES = 4000  # along one edge: under half a pixel apart at 2048 wide
+
+
+def room_picture(panorama: np.ndarray, room: RoomFit, clicks: RoomClicks | None = None, *,
+                 rotation: np.ndarray | None = None, max_width: int = 2048) -> np.ndarray:
+    """(h, w, 3) uint8 sRGB picture of `panorama` (H, W, 3) linear RGB, top row first, reduced
+    to at most `max_width` wide, with `room`'s edges and the `clicks` drawn."""
+    image = np.asarray(panorama, dtype=np.float32)
+    height, width = image.shape[:2]
+    if width > max_width:
+        height, width = max(1, round(height * max_width / width)), max_width
+        image = resample_axis(resample_axis(image, height, axis=0), width, axis=1)
+    picture = _tone_map(image)
+    edges = room_edges(room) - room.probe
+    t = np.linspace(0.0, 1.0, _SAMPLES)[None, :, None]
+    points = edges[:, :1] + t * (edges[:, 1:] - edges[:, :1])
+    xy = project(points, width, height, rotation)
+    kind = np.repeat(np.arange(3), len(edges) // 3)
+    colour = np.broadcast_to(_COLOURS[kind][:, None, :], (*xy.shape[:2], 3))
+    _stamp(picture, xy.reshape(-1, 2), colour.reshape(-1, 3), radius=1)
+    if clicks is not None:
+        scale = np.array([width / clicks.width, height / clicks.height])
+        named = [*clicks.floor, *([clicks.ceiling] if clicks.ceiling is not None else [])]
+        marks = (np.asarray(named, dtype=np.float64) + 0.5) * scale - 0.5
+        arms = np.arange(-4, 5)
+        cross = np.concatenate([np.stack([arms, arms], 1), np.stack([arms, -arms], 1)])
+        stamped = (marks[:, None, :] + cross[None]).reshape(-1, 2)
+        _stamp(picture, stamped, np.broadcast_to(_CLICK, (len(stamped), 3)), radius=0)
+    return np.round(_srgb(picture) * 255.0).astype(np.uint8)
+
+
+def _stamp(picture: np.ndarray, xy: np.ndarray, colour: np.ndarray, *, radius: int) -> None:
+    """Paint the pixels at `xy` (n, 2) and their neighbours within `radius` (wrapping in x)."""
+    height, width = picture.shape[:2]
+    col, row = np.round(xy[:, 0]).astype(np.int64), np.round(xy[:, 1]).astype(np.int64)
+    for dy in range(-radius, radius + 1):
+        for dx in range(-radius, radius + 1):
+            r = row + dy
+            ok = (r >= 0) & (r < height)
+            picture[r[ok], np.mod(col[ok] + dx, width)] = colour[ok]

@@ -1,0 +1,275 @@
+"""Match Room: click the room's floor corners in the panorama, then build Floor, Walls and Ceiling.
+
+`dimred.room_click` adds clicks: interactively in an Image Editor showing the panorama (left
+click a floor corner, Ctrl+click the wall-ceiling point, Shift+click the known length's ends,
+Enter or right click to match, Esc to stop), or from a script with `kind`, `x` and `y`.
+`dimred.match_room` fits the room to the clicks (`addon.roommatch`), builds it, sets the probe
+centre and draws the room diagnostics picture. Click files (`dimred room`'s JSON) load and save.
+"""
+from __future__ import annotations
+
+import json
+
+import bpy
+from bpy.props import EnumProperty, FloatProperty, IntProperty, StringProperty
+
+from ..addon.errors import DimredError
+from .support import pictures
+
+ROOM_DIAGNOSTICS_IMAGE = "Dimred Room Diagnostics"
+
+KIND_ITEMS = (
+    ('FLOOR', "Floor Corner", "A corner of the floor, in order round the room"),
+    ('CEILING', "Ceiling Point", "A point where a wall meets the ceiling"),
+    ('LENGTH_START', "Length Start", "The known length's start (on the floor)"),
+    ('LENGTH_END', "Length End", "The known length's end"),
+)
+
+
+def add_click(scene: bpy.types.Scene, kind: str, x: float, y: float) -> str:
+    """Record one click; the message says what it was."""
+    room = scene.dimred_room
+    if kind == 'FLOOR':
+        room.corners.add().point = (x, y)
+        return f"floor corner {len(room.corners) - 1} at ({x:.1f}, {y:.1f})"
+    if kind == 'CEILING':
+        room.ceiling, room.use_ceiling = (x, y), True
+        return f"ceiling point at ({x:.1f}, {y:.1f})"
+    if kind == 'LENGTH_START':
+        room.length_start = (x, y)
+    else:
+        room.length_end = (x, y)
+    return f"known length's {'start' if kind == 'LENGTH_START' else 'end'} at ({x:.1f}, {y:.1f})"
+
+
+def match(scene: bpy.types.Scene) -> str:
+    """Fit and build the room from the scene's clicks; the summary line. DimredError: nothing changed."""
+    from ..addon.blender import reader, room_builder
+    from ..addon.roommatch.diagnostics import room_picture
+
+    room = scene.dimred_room
+    clicks = room.clicks()
+    fitted = room_builder.match_room(scene, clicks, ceiling_height=room.ceiling_height)
+    room.matched, room.problem = True, ""
+    room.summary = json.dumps(fitted.summary())
+    try:
+        panorama = reader.panorama_pixels(scene)
+    except DimredError:
+        panorama = None  # no panorama in the world: the room stands, there is nothing to draw it over
+    if panorama is not None:
+        picture = pictures.Picture.of(room_picture(panorama, fitted, clicks,
+                                                   rotation=room_builder.panorama_rotation(scene)))
+        pictures.show_diagnostics(picture, ROOM_DIAGNOSTICS_IMAGE)
+    return (f"Room matched: {len(clicks.floor)} corners, camera {fitted.camera_height:.2f} m "
+            f"({fitted.scale_source}), ceiling {fitted.ceiling_height:.2f} m, "
+            f"corners within {fitted.corner_errors.max():.2f} px of their clicks")
+
+
+class DIMRED_OT_match_room(bpy.types.Operator):
+    bl_idname = "dimred.match_room"
+    bl_label = "Match Room"
+    bl_description = ("Build Floor, Walls and Ceiling from the clicked floor corners and the camera height (or a "
+                      "known length), and set the probe centre where the camera was")
+    bl_options = {'REGISTER', 'UNDO'}
+
+    def execute(self, context: bpy.types.Context) -> set[str]:
+        try:
+            message = match(context.scene)
+        except DimredError as error:
+            self.report({'ERROR'}, str(error))
+            return {'CANCELLED'}
+        self.report({'INFO'}, message)
+        return {'FINISHED'}
+
+
+class DIMRED_OT_room_click(bpy.types.Operator):
+    bl_idname = "dimred.room_click"
+    bl_label = "Click Room"
+    bl_description = ("Click the floor's corners in order round the room in the Image Editor showing the panorama "
+                      "(Ctrl: the wall-ceiling point, Shift: the known length's ends); Enter or right click matches "
+                      "the room, Esc stops")
+    bl_options = {'REGISTER', 'UNDO'}
+
+    kind: EnumProperty(name="Kind", items=KIND_ITEMS, default='FLOOR')
+    x: FloatProperty(name="Column", description="Pixels from the left, pixel centres at whole numbers")
+    y: FloatProperty(name="Row", description="Pixels from the top, pixel centres at whole numbers")
+    width: IntProperty(name="Width", description="The panorama's width in pixels (0: the world's)", min=0)
+    height: IntProperty(name="Height", description="The panorama's height in pixels (0: the world's)", min=0)
+
+    def execute(self, context: bpy.types.Context) -> set[str]:
+        room = context.scene.dimred_room
+        size = (self.width, self.height) if self.width and self.height else _world_size(context.scene)
+        if size is None:
+            self.report({'ERROR'}, "give the panorama's width and height: the world shows no panorama")
+            return {'CANCELLED'}
+        if room.corners and (room.width, room.height) != size:
+            self.report({'ERROR'}, f"the clicks so far were made on a {room.width} × {room.height} panorama, not "
+                                   f"{size[0]} × {size[1]}: clear them first")
+            return {'CANCELLED'}
+        room.updating = True
+        room.width, room.height = size
+        room.updating = False
+        self.report({'INFO'}, "Added " + add_click(context.scene, self.kind, self.x, self.y))
+        return {'FINISHED'}
+
+    def invoke(self, context: bpy.types.Context, event: bpy.types.Event) -> set[str]:
+        space = context.space_data
+        if context.area is None or context.area.type != 'IMAGE_EDITOR' or space.image is None:
+            self.report({'ERROR'}, "show the panorama in an Image Editor and start Click Room there")
+            return {'CANCELLED'}
+        context.window_manager.modal_handler_add(self)
+        context.workspace.status_text_set("Click Room: click floor corners in order; Ctrl: ceiling point; "
+                                          "Shift: known length's ends; Enter/right click: match; Esc: stop")
+        return {'RUNNING_MODAL'}
+
+    def modal(self, context: bpy.types.Context, event: bpy.types.Event) -> set[str]:
+        if event.type in {'ESC'} and event.value == 'PRESS':
+            context.workspace.status_text_set(None)
+            return {'CANCELLED'}
+        if event.type in {'RET', 'NUMPAD_ENTER', 'RIGHTMOUSE'} and event.value == 'PRESS':
+            context.workspace.status_text_set(None)
+            bpy.ops.dimred.match_room()
+            return {'FINISHED'}
+        if event.type == 'LEFTMOUSE' and event.value == 'PRESS':
+            image = context.space_data.image
+            u, v = context.region.view2d.region_to_view(event.mouse_region_x, event.mouse_region_y)
+            self.width, self.height = image.size
+            self.x, self.y = u * self.width - 0.5, (1.0 - v) * self.height - 0.5
+            room = context.scene.dimred_room
+            shift_kind = 'LENGTH_END' if tuple(room.length_start) != (0.0, 0.0) else 'LENGTH_START'
+            self.kind = 'CEILING' if event.ctrl else shift_kind if event.shift else 'FLOOR'
+            self.execute(context)
+            context.area.tag_redraw()
+            return {'RUNNING_MODAL'}
+        return {'PASS_THROUGH'}
+
+
+class DIMRED_OT_room_remove_corner(bpy.types.Operator):
+    bl_idname = "dimred.room_remove_corner"
+    bl_label = "Remove Corner"
+    bl_description = "Remove a clicked floor corner (the last one by default)"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    index: IntProperty(name="Corner", default=-1)
+
+    def execute(self, context: bpy.types.Context) -> set[str]:
+        corners = context.scene.dimred_room.corners
+        index = self.index if self.index >= 0 else len(corners) - 1
+        if not 0 <= index < len(corners):
+            self.report({'ERROR'}, f"there is no floor corner {self.index}")
+            return {'CANCELLED'}
+        corners.remove(index)
+        return {'FINISHED'}
+
+
+class DIMRED_OT_room_clear(bpy.types.Operator):
+    bl_idname = "dimred.room_clear"
+    bl_label = "Clear Clicks"
+    bl_description = "Forget the room's clicks (the room's meshes stay)"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    def execute(self, context: bpy.types.Context) -> set[str]:
+        room = context.scene.dimred_room
+        room.updating = True
+        room.corners.clear()
+        room.use_ceiling = room.matched = False
+        room.width = room.height = 0
+        room.length_start = room.length_end = (0.0, 0.0)
+        room.problem = room.summary = ""
+        room.updating = False
+        return {'FINISHED'}
+
+
+class DIMRED_OT_room_load_clicks(bpy.types.Operator):
+    bl_idname = "dimred.room_load_clicks"
+    bl_label = "Load Clicks"
+    bl_description = "Load a click file (JSON, as `dimred room` takes it), or the clicks the scene's room was made from"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    filepath: StringProperty(name="File Path", subtype='FILE_PATH')
+
+    def invoke(self, context: bpy.types.Context, event: bpy.types.Event) -> set[str]:
+        context.window_manager.fileselect_add(self)
+        return {'RUNNING_MODAL'}
+
+    def execute(self, context: bpy.types.Context) -> set[str]:
+        from ..addon.blender import room_builder
+        from ..addon.roommatch import clicks as click_file
+
+        try:
+            if self.filepath:
+                try:
+                    with open(bpy.path.abspath(self.filepath), encoding="utf-8") as handle:
+                        clicks = click_file.from_json(handle.read())
+                except OSError as error:
+                    raise DimredError(f"cannot read the click file: {error.strerror}: {self.filepath}") from None
+            else:
+                clicks = room_builder.stored_clicks(context.scene)
+                if clicks is None:
+                    raise DimredError("the scene keeps no clicks of a matched room: give a click file")
+        except DimredError as error:
+            self.report({'ERROR'}, str(error))
+            return {'CANCELLED'}
+        context.scene.dimred_room.load(clicks)
+        self.report({'INFO'}, f"Loaded {len(clicks.floor)} floor corners")
+        return {'FINISHED'}
+
+
+class DIMRED_OT_room_save_clicks(bpy.types.Operator):
+    bl_idname = "dimred.room_save_clicks"
+    bl_label = "Save Clicks"
+    bl_description = "Save the clicks as a click file (JSON), for `dimred room` or another scene"
+
+    filepath: StringProperty(name="File Path", subtype='FILE_PATH')
+
+    def invoke(self, context: bpy.types.Context, event: bpy.types.Event) -> set[str]:
+        if not self.filepath:
+            self.filepath = "room_clicks.json"
+        context.window_manager.fileselect_add(self)
+        return {'RUNNING_MODAL'}
+
+    def execute(self, context: bpy.types.Context) -> set[str]:
+        try:
+            text = context.scene.dimred_room.clicks().to_json()
+            path = bpy.path.ensure_ext(bpy.path.abspath(self.filepath), ".json")
+            with open(path, "w", encoding="utf-8") as handle:
+                handle.write(text)
+        except DimredError as error:
+            self.report({'ERROR'}, str(error))
+            return {'CANCELLED'}
+        except OSError as error:
+            self.report({'ERROR'}, f"cannot write the click file: {error.strerror}: {self.filepath}")
+            return {'CANCELLED'}
+        self.report({'INFO'}, f"Saved the clicks to {path}")
+        return {'FINISHED'}
+
+
+class DIMRED_OT_show_room_diagnostics(bpy.types.Operator):
+    bl_idname = "dimred.show_room_diagnostics"
+    bl_label = "Show Room Diagnostics"
+    bl_description = "Show the panorama with every edge of the matched room drawn over it in an Image Editor"
+
+    @classmethod
+    def poll(cls, context: bpy.types.Context) -> bool:
+        return ROOM_DIAGNOSTICS_IMAGE in bpy.data.images
+
+    def execute(self, context: bpy.types.Context) -> set[str]:
+        if not pictures.show_in_editor(context, bpy.data.images[ROOM_DIAGNOSTICS_IMAGE]):
+            self.report({'WARNING'}, "no window to show the picture in")
+            return {'CANCELLED'}
+        return {'FINISHED'}
+
+
+def _world_size(scene: bpy.types.Scene) -> tuple[int, int] | None:
+    from ..addon.blender import reader
+
+    try:
+        return reader.panorama_size(scene)
+    except DimredError:
+        return None
+
+
+classes = (DIMRED_OT_match_room, DIMRED_OT_room_click, DIMRED_OT_room_remove_corner, DIMRED_OT_room_clear,
+           DIMRED_OT_room_load_clicks, DIMRED_OT_room_save_clicks, DIMRED_OT_show_room_diagnostics)
+
+register, unregister = bpy.utils.register_classes_factory(classes)

@@ -1,0 +1,112 @@
+"""Match Room through bpy as a user works: clicks added with `dimred.room_click`, the room built
+by `dimred.match_room`, read back from the meshes; a moved click re-fits; bad clicks change
+nothing."""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import bpy
+import numpy as np
+import pytest
+
+from tests.blender import tiny_scene
+from tests.engine.roommatch.room_truth import clicks_of, distance_errors, flat_panorama, floor_points
+
+W, H = 512, 256
+BOX = np.array([(-2.0, -1.5), (3.0, -1.5), (3.0, 2.5), (-2.0, 2.5)])
+PROBE = np.array([0.0, 0.0, 1.5])
+CEILING = 2.6
+
+
+@pytest.fixture
+def panorama_room(registered, tmp_path: Path) -> np.ndarray:
+    """An empty scene whose world shows a flat panorama of the box room; returns the floor clicks."""
+    from addon.blender import room_builder
+
+    hdri = tmp_path / "room.exr"
+    tiny_scene.write_exr(hdri, flat_panorama(BOX, CEILING, PROBE, W, H))
+    room_builder.show_panorama(bpy.context.scene, str(hdri))
+    return clicks_of(floor_points(BOX), PROBE, W, H)
+
+
+def _vertices(name: str) -> np.ndarray:
+    mesh = bpy.data.objects[name].data
+    out = np.empty(3 * len(mesh.vertices))
+    mesh.vertices.foreach_get("co", out)
+    return out.reshape(-1, 3)
+
+
+def _click_all(points: np.ndarray) -> None:
+    for x, y in points:
+        bpy.ops.dimred.room_click(kind='FLOOR', x=float(x), y=float(y))
+
+
+def test_match_room_builds_the_room_the_clicks_show(panorama_room: np.ndarray) -> None:
+    scene = bpy.context.scene
+    _click_all(panorama_room)
+    ceiling = clicks_of(np.array([[3.0, 0.5, CEILING]]), PROBE, W, H)[0]
+    bpy.ops.dimred.room_click(kind='CEILING', x=float(ceiling[0]), y=float(ceiling[1]))
+    scene.dimred_room.camera_height = 1.5
+    assert bpy.ops.dimred.match_room() == {'FINISHED'}
+
+    floor = _vertices("Floor")
+    assert np.allclose(floor[:, 2], 0.0)
+    found = floor[[int(np.argmin(np.linalg.norm(floor[:, :2] - c, axis=1))) for c in BOX], :2]
+    assert distance_errors(found, BOX, PROBE).max() < 0.02  # 512 wide: a whole pixel is 0.7 degrees
+    assert len(bpy.data.objects["Walls"].data.polygons) == 4
+    assert _vertices("Ceiling")[:, 2] == pytest.approx(CEILING, rel=0.03)
+    assert tuple(scene.objects["ProbeCenter"].location) == pytest.approx((0.0, 0.0, 1.5))
+    assert tuple(scene.dimred.probe_center) == pytest.approx((0.0, 0.0, 1.5)) and scene.dimred.use_probe_center
+    picture = bpy.data.images["Dimred Room Diagnostics"]
+    assert tuple(picture.size) == (W, H)
+    assert json.loads(scene.dimred_room.summary)["camera_height_m"] == 1.5
+
+
+def test_moving_a_click_refits_the_room(panorama_room: np.ndarray) -> None:
+    scene = bpy.context.scene
+    _click_all(panorama_room)
+    scene.dimred_room.camera_height = 1.5
+    bpy.ops.dimred.match_room()
+    moved = clicks_of(np.array([[-2.5, -1.5, 0.0]]), PROBE, W, H, rounded=False)[0]
+    scene.dimred_room.corners[0].point = tuple(moved)  # a user dragging corner 0 half a metre along the wall
+    floor = _vertices("Floor")
+    assert np.min(np.linalg.norm(floor[:, :2] - (-2.5, -1.5), axis=1)) < 0.02
+    scene.dimred_room.camera_height = 2.0  # and a new height scales the room about the probe at once
+    assert np.min(np.linalg.norm(_vertices("Floor")[:, :2] - (-2.5 * 4 / 3, -2.0), axis=1)) < 0.03
+
+
+def test_bad_clicks_change_nothing(panorama_room: np.ndarray) -> None:
+    scene = bpy.context.scene
+    _click_all(panorama_room[:2])
+    with pytest.raises(RuntimeError, match="a floor needs 3 or more corners, 2 clicked"):
+        bpy.ops.dimred.match_room()
+    assert "Floor" not in bpy.data.objects and "ProbeCenter" not in bpy.data.objects
+
+    _click_all(panorama_room[2:])
+    bpy.ops.dimred.match_room()
+    before = _vertices("Floor")
+    scene.dimred_room.corners[1].point = (panorama_room[1][0], 60.0)  # above the horizon: refused, shown
+    assert "floor corner 1" in scene.dimred_room.problem
+    assert np.array_equal(_vertices("Floor"), before)
+    scene.dimred_room.corners[1].point = tuple(panorama_room[1])
+    scene.dimred_room.camera_height = 0.0
+    with pytest.raises(RuntimeError, match="camera height must be above 0 m"):
+        bpy.ops.dimred.match_room()
+    assert np.array_equal(_vertices("Floor"), before)
+    with pytest.raises(RuntimeError, match="outside the 512 × 256 panorama"):
+        bpy.ops.dimred.room_click(kind='FLOOR', x=600.0, y=200.0)
+        scene.dimred_room.camera_height = 1.5
+        bpy.ops.dimred.match_room()
+    assert np.array_equal(_vertices("Floor"), before)
+
+
+def test_click_files_load_and_save(panorama_room: np.ndarray, tmp_path: Path) -> None:
+    _click_all(panorama_room)
+    bpy.ops.dimred.room_save_clicks(filepath=str(tmp_path / "clicks.json"))
+    saved = json.loads((tmp_path / "clicks.json").read_text())
+    assert saved["floor"] == panorama_room.tolist() and saved["width"] == W
+    bpy.ops.dimred.room_clear()
+    assert len(bpy.context.scene.dimred_room.corners) == 0
+    bpy.ops.dimred.room_load_clicks(filepath=str(tmp_path / "clicks.json"))
+    assert [tuple(c.point) for c in bpy.context.scene.dimred_room.corners] == [tuple(p) for p in panorama_room]
