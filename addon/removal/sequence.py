@@ -31,6 +31,7 @@ from .occlusion import occluders
 from .propagation import propagate_change
 from .relit_noise import relit_noise_stage
 from .room import solve_room
+from .seam import seamless_panorama_change
 from .solution import Solution
 from .target import Target, object_index, prepare
 from .trace import Traced, trace
@@ -138,12 +139,13 @@ def finish(solution: Solution, rep: Report, callbacks: RunCallbacks = NO_CALLBAC
             found = working_revealed(solution)
             light = hidden_light(solution, found, callbacks)
         with rep.stage("synthesis"):
-            d_revealed = fill_hidden(solution, found, light, rep, callbacks, show)
+            # the seam is the fill's last step: it stays within the stages a removal reports
+            difference = _seamless(solution, difference_image(fill_hidden(solution, found, light, rep, callbacks,
+                                                                          show)))
     else:
-        d_revealed = np.zeros((0, 3))
+        difference = difference_image(np.zeros((0, 3)))
         rep.skip("synthesis", "the object is not visible from the probe centre: no hidden region to fill"
                  if not traced.hidden_map.any() else "nothing is behind the object to fill")
-    difference = difference_image(d_revealed)
     rep.info["hidden_region_filled"] = bool(len(revealed) == traced.hidden_map.sum())
     return RemovalResult(difference=difference, hidden_mask=traced.hidden_map, report=rep.as_dict(),
                          hdri=solution.hdri, seen=solution.seen)
@@ -198,6 +200,18 @@ def _quiet_working(solution: Solution, d_h: np.ndarray, rep: Report) -> np.ndarr
                               surface.reshape(traced.height, traced.width),
                               enabled=solution.params.match_relit_noise, rep=rep)
     return quiet.change.reshape(-1, 3)[traced.hp]
+
+
+def _seamless(solution: Solution, difference: np.ndarray) -> np.ndarray:
+    """The working panorama's `difference` (H, W, 3) with the filled pixels' step against the
+    relit photograph around them taken out (`seam`)."""
+    traced = solution.traced
+    shape = (traced.height, traced.width)
+    filled = np.zeros(traced.height * traced.width, dtype=bool)
+    filled[traced.hp[traced.behind.revealed]] = True
+    tri = traced.behind.tri_without
+    surface = np.where(tri >= 0, solution.target.surface_key[np.maximum(tri, 0)], -1).reshape(shape)
+    return seamless_panorama_change(np.asarray(solution.hdri, np.float32), difference, filled.reshape(shape), surface)
 
 
 def _hit_image(traced: Traced, rows: np.ndarray) -> np.ndarray:

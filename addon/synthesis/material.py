@@ -14,7 +14,7 @@ with a cell of margin; beside the hole it is repainted, so that nothing continue
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -42,25 +42,28 @@ class Material:
     replaced: np.ndarray
     source: str
     share: float  # exemplar cells / known cells
+    decided: bool = True  # False: too little is seen around the hole to tell its material
 
     @property
     def mostly_other(self) -> bool:
-        """Most of the surface seen around the hole is of another material (clutter, a rug)."""
-        return self.source != "border material" or self.share < _MIN_SHARE_WARN
+        """Most of the surface seen around the hole is of another material (clutter, a rug), or
+        none of it matches."""
+        return self.decided and (self.source != "border material" or self.share < _MIN_SHARE_WARN)
 
 
 def border_material(image: np.ndarray, known: np.ndarray, hole: np.ndarray, *, min_cells: int) -> Material:
     """The cells of `image` (h, w, 3 reflectance) among `known` whose material surrounds `hole`;
     the whole of `known` where fewer than `min_cells` match."""
-    whole = Material(exemplar=known, replaced=np.zeros_like(known), source="whole surface", share=1.0)
+    undecided = Material(exemplar=known, replaced=np.zeros_like(known), source="whole surface", share=1.0,
+                         decided=False)
     if not hole.any():
-        return whole
+        return undecided
     reach = int(np.clip(round(hole_extent(hole) / 2), 4, 32))
     near = dilate(hole, reach) & ~hole
     # The ring's inner half holds the contact shadow and the legs: only its outer half decides.
     around = known & near & ~dilate(hole, reach // 2)
     if not around.any():
-        return whole
+        return undecided
     mean, _ = box_mean(np.concatenate([np.log(np.maximum(image @ LUMA, 1e-4))[..., None],
                                        image[..., :2] / np.maximum(image.sum(axis=-1, keepdims=True), 1e-6)],
                                       axis=-1), known, 1)
@@ -76,7 +79,7 @@ def border_material(image: np.ndarray, known: np.ndarray, hole: np.ndarray, *, m
     per_sector = counts.sum(axis=0)
     counted = per_sector >= _MIN_SECTOR_CELLS
     if not counted.any():
-        return whole
+        return undecided
     near_counts = _neighbour_sum(counts.reshape(*shape, _SECTORS))
     present = near_counts.reshape(-1, _SECTORS) >= np.maximum(_PRESENT * per_sector, 2.0)
     common = (present & counted).sum(axis=1) >= _AROUND * counted.sum()
@@ -86,7 +89,7 @@ def border_material(image: np.ndarray, known: np.ndarray, hole: np.ndarray, *, m
     other = dilate(dilate(erode(known & ~matching, 1), 1), 1) & known
     exemplar = known & ~other
     if exemplar.sum() < min_cells:
-        return whole
+        return replace(undecided, decided=True)
     return Material(exemplar=exemplar, replaced=near & other, source="border material",
                     share=float(exemplar.sum() / known.sum()))
 

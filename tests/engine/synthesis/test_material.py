@@ -73,13 +73,26 @@ def test_a_surface_mostly_of_clutter_still_draws_on_the_border_material() -> Non
     assert not (got.exemplar & clutter).any()
 
 
-def test_without_any_match_the_whole_surface_is_used() -> None:
+def test_seen_only_far_from_the_hole_the_whole_surface_is_used_without_a_warning() -> None:
     image = np.full((_H, _W, 3), 0.5)
     hole = _hole()
-    known = ~hole & (np.indices((_H, _W))[1] > 150)  # seen only far away: no ring at all
+    known = ~hole & (np.indices((_H, _W))[1] > 150)  # seen only far away: no ring at all, nothing to tell
     got = border_material(image, known, hole, min_cells=64)
     assert got.source == "whole surface"
     assert np.array_equal(got.exemplar, known)
+    assert not got.decided and not got.mostly_other
+
+
+def test_without_any_match_the_whole_surface_is_used_and_said() -> None:
+    hole = _hole()
+    # around the hole a patchwork of colours each on one side only; the match is too small
+    rows, cols = np.indices((_H, _W))
+    sector = ((np.arctan2(rows - 62, cols - 75) + np.pi) / (2 * np.pi) * 8).astype(int) % 8
+    image = np.array([[0.8, 0.1, 0.1], [0.1, 0.8, 0.1], [0.1, 0.1, 0.8], [0.8, 0.8, 0.1],
+                      [0.1, 0.8, 0.8], [0.8, 0.1, 0.8], [0.05, 0.05, 0.05], [0.9, 0.9, 0.9]])[sector]
+    got = border_material(image, ~hole, hole, min_cells=64)
+    assert got.source == "whole surface" and got.decided
+    assert np.array_equal(got.exemplar, ~hole)
     assert got.mostly_other
 
 

@@ -1,0 +1,111 @@
+"""The filled pixels joined to the photograph around them without a step.
+
+The fill is lit by the irradiance after the removal and the pixels around it by the ratio form,
+two estimates that agree on average but not exactly: a proxy a few centimetres off, a lamp's
+falloff, the synthesis's mean a few percent away, and the fill's edge shows as a step. It is
+taken out in the gradient domain, in linear radiance: per surface, the step between the
+photograph's side and the fill's side of the boundary (each a local mean over a band, so that
+neither side's texture moves it) is spread over the filled pixels as a smooth membrane that is
+the step at the boundary and varies slowly inside. The fill keeps its own gradients.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..light.radiosity import LUMA
+from ..segmentation.masks import box_mean, dilate
+
+# A boundary pixel's step is measured over the band within this share of the filled region's
+# extent around it (in pixels, within the bounds), each side's band half as deep: wide enough
+# that a texture's tiles, planks and grain average out on both sides.
+_REACH, _MIN_REACH, _MAX_REACH = 1 / 3, 4, 24
+# A texture's own local means vary from place to place (a tile or a plank more in one band, the
+# gap between them in the other), and a fill continuing it right still differs from the other
+# side by as much. So a step is taken only as far as it stands out of how much the surface's
+# local means vary around the hole (beyond `_SIGNIFICANCE` times their spread), and averaged
+# along the boundary over twice the reach.
+_ALONG = 2
+_SIGNIFICANCE = 2.0
+_AROUND = 4  # reaches: the surface around the hole whose local means give their spread
+def seamless_change(radiance: np.ndarray, change: np.ndarray, filled: np.ndarray, surface: np.ndarray
+                    ) -> np.ndarray:
+    """(h, w, 3) `change` with the `filled` pixels' (h, w) step against the rest taken out, per
+    `surface` (h, w, the surface id each pixel shows once the object is gone; -1: none), for a
+    photograph `radiance` (h, w, 3). Nothing changes outside `filled`; no radiance goes below 0."""
+    out = np.array(change, dtype=np.float32, copy=True)
+    edited = np.maximum(radiance, 0.0) + out
+    for s in np.unique(surface[filled]):
+        if s < 0:
+            continue
+        inside = filled & (surface == s)
+        outside = ~filled & (surface == s)
+        rows, cols = np.nonzero(inside)
+        reach = int(np.clip(_REACH * max(np.ptp(rows), np.ptp(cols), 1), _MIN_REACH, _MAX_REACH))
+        band = max(reach // 2, 1)
+        inner = inside & dilate(outside, band)
+        outer = outside & dilate(inside, band)
+        if not inner.any() or not outer.any():
+            continue
+        m_out, n_out = box_mean(edited, outer, reach)
+        m_in, n_in = box_mean(edited, inner, reach)
+        boundary = inside & dilate(outside, 1) & (n_out > 0) & (n_in > 0)
+        if not boundary.any():
+            continue
+        spread = _local_spread(edited, outside & dilate(inside, _AROUND * reach), reach)
+        step, _ = box_mean(np.where(boundary[..., None], m_out - m_in, 0.0), boundary, _ALONG * reach)
+        kept = np.clip(1 - (_SIGNIFICANCE * spread / np.maximum(np.abs(step @ LUMA), 1e-30)) ** 2, 0.0, 1.0)
+        membrane = _pull_push(np.where(boundary[..., None], step * kept[..., None], 0.0), boundary)
+        out[inside] += membrane[inside].astype(np.float32)
+    np.maximum(out, -np.maximum(radiance, 0.0), out=out)
+    return out
+
+
+def _local_spread(edited: np.ndarray, around: np.ndarray, radius: int) -> float:
+    """The spread (standard deviation) of the luminance's local means over squares of `radius`
+    lying mostly on the pixels `around`; infinite where too few such squares are there."""
+    mean, count = box_mean(edited @ LUMA[:, None], around, radius)
+    full = around & (count >= 0.5 * (2 * radius + 1) ** 2)
+    if full.sum() < 2 * radius:
+        return float("inf")
+    return float(mean[full, 0].std())
+
+
+def _pull_push(values: np.ndarray, known: np.ndarray) -> np.ndarray:
+    """(h, w, c) a smooth field through `values` where `known` (h, w): known pixels averaged into
+    ever coarser levels, then every level's gaps filled from the next coarser, smoothed."""
+    if known.all():
+        return values
+    if min(known.shape) <= 1:
+        return np.where(known[..., None], values, values[known].mean(axis=0) if known.any() else 0.0)
+    h, w = known.shape
+    weight = known.astype(np.float64)
+    pad = ((0, h % 2), (0, w % 2))
+    wv = np.pad(values * weight[..., None], (*pad, (0, 0)))
+    wp = np.pad(weight, pad)
+    coarse_w = wp[0::2, 0::2] + wp[1::2, 0::2] + wp[0::2, 1::2] + wp[1::2, 1::2]
+    coarse_v = wv[0::2, 0::2] + wv[1::2, 0::2] + wv[0::2, 1::2] + wv[1::2, 1::2]
+    has = coarse_w > 0
+    coarse = _pull_push(np.where(has[..., None], coarse_v / np.maximum(coarse_w, 1e-12)[..., None], 0.0), has)
+    up = np.repeat(np.repeat(coarse, 2, axis=0), 2, axis=1)[:h, :w]
+    smooth, _ = box_mean(up, np.ones((h, w)), 1)
+    return np.where(known[..., None], values, smooth)
+
+
+def seamless_panorama_change(radiance: np.ndarray, change: np.ndarray, filled: np.ndarray, surface: np.ndarray
+                             ) -> np.ndarray:
+    """`seamless_change` over a whole lat-long panorama: turned by whole columns so that the
+    filled pixels lie away from the u seam, where the image's columns wrap around."""
+    if not filled.any():
+        return np.asarray(change, dtype=np.float32)
+    width = filled.shape[1]
+    columns = np.flatnonzero(filled.any(axis=0))
+    # the middle of the filled columns' widest gap is where the seam goes
+    gaps = np.diff(np.concatenate([columns, [columns[0] + width]]))
+    widest = int(np.argmax(gaps))
+    turn = -(int(columns[widest]) + int(gaps[widest]) // 2)
+
+    def turned(a: np.ndarray) -> np.ndarray:
+        return np.roll(a, turn, axis=1)
+
+    got = seamless_change(turned(radiance), turned(change), turned(filled), turned(surface))
+    return np.roll(got, -turn, axis=1)

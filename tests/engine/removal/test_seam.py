@@ -1,0 +1,61 @@
+"""The fill meets the photograph without a step, keeping its own texture."""
+from __future__ import annotations
+
+import numpy as np
+
+from addon.removal.seam import seamless_change
+
+_H, _W = 80, 120
+
+
+def _scene(step: float, seed: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """A textured floor relit by +5 %, a square filled with texture `step` brighter than it
+    should be; the surface is 0 below row 40, 1 above (a wall 3 times brighter)."""
+    rng = np.random.default_rng(seed)
+    surface = np.where(np.arange(_H)[:, None] >= 40, 0, 1) * np.ones((_H, _W), np.int64)
+    base = np.where(surface == 0, 0.3, 0.9)[..., None] * np.array([1.0, 0.9, 0.8])
+    radiance = base * (1 + 0.1 * rng.standard_normal((_H, _W, 1)))
+    filled = np.zeros((_H, _W), bool)
+    filled[25:60, 40:80] = True
+    truth = radiance * 1.05
+    fill = base * (1 + step) * 1.05 * (1 + 0.1 * rng.standard_normal((_H, _W, 1)))
+    edited = np.where(filled[..., None], fill, truth)
+    return radiance, (edited - radiance).astype(np.float32), filled, surface
+
+
+def _step(edited: np.ndarray, filled: np.ndarray, surface: np.ndarray, s: int) -> float:
+    """Relative step of the mean over 3 pixels inside against 3 outside, on the filled rows of
+    surface `s`, at the fill's left and right edges."""
+    rows = np.flatnonzero((surface[:, 0] == s) & filled[:, 60])
+    band = edited[rows]
+    inside = band[:, 40:43].mean() + band[:, 77:80].mean()
+    outside = band[:, 37:40].mean() + band[:, 80:83].mean()
+    return abs(inside / outside - 1)
+
+
+def test_a_step_on_two_surfaces_is_taken_out_and_the_texture_kept() -> None:
+    radiance, change, filled, surface = _scene(0.12)
+    got = seamless_change(radiance, change, filled, surface)
+    before, after = radiance + change, radiance + got
+    for s in (0, 1):
+        assert _step(before, filled, surface, s) > 0.08
+        assert _step(after, filled, surface, s) < 0.02
+    assert np.array_equal(got[~filled], change[~filled])
+    # the fill's own texture: its high-pass is what it was
+    def high(a: np.ndarray) -> np.ndarray:
+        return a[30:55, 45:75] - a[29:54, 45:75]
+    assert np.abs(high(after) - high(before)).mean() < 0.05 * np.abs(high(before)).mean()
+
+
+def test_without_a_step_little_changes() -> None:
+    radiance, change, filled, surface = _scene(0.0, seed=1)
+    got = seamless_change(radiance, change, filled, surface)
+    edited = radiance + change
+    assert np.abs(got - change)[filled].mean() < 0.03 * np.abs(edited[filled]).mean()
+
+
+def test_no_radiance_goes_negative() -> None:
+    radiance, change, filled, surface = _scene(-0.9, seed=2)
+    change[filled] -= 1.0
+    got = seamless_change(radiance, change, filled, surface)
+    assert (radiance + got >= -1e-6).all()
