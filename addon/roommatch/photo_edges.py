@@ -49,30 +49,50 @@ def edge_offsets(panorama: np.ndarray, room: RoomFit, *, rotation: np.ndarray | 
                  search: float = 6.0, min_shown: float = 0.3) -> EdgeOffsets:
     """Offsets of `room`'s edges from the edges of `panorama` (H, W, 3) linear RGB, top row
     first, measured at `width` x `width` / 2."""
-    height = width // 2
-    image = np.asarray(panorama, dtype=np.float32)
-    image = resample_axis(resample_axis(image, height, axis=0), width, axis=1)
-    log = np.log(np.maximum(image @ _LUMINANCE.astype(np.float32), 1e-4)).astype(np.float64)
-    log = _blur(log)
+    log = log_luminance(panorama, width)
     offsets, shown = [], []
     for a, b in room_edges(room) - room.probe:
-        found = _edge_samples(log, a, b, rotation, search)
+        found = edge_samples(log, a, b, rotation, search).offsets
         shown.append(float(np.mean(~np.isnan(found))) if found.size else 0.0)
         ok = found[~np.isnan(found)]
         offsets.append(float(np.median(np.abs(ok))) if found.size and ok.size >= min_shown * found.size else np.nan)
     return EdgeOffsets(width=width, offsets=np.array(offsets), shown=np.array(shown))
 
 
-def _edge_samples(log: np.ndarray, a: np.ndarray, b: np.ndarray, rotation: np.ndarray | None,
-                  search: float) -> np.ndarray:
-    """Signed offsets (pixels) of the strongest change across the curve, NaN where none."""
+def log_luminance(panorama: np.ndarray, width: int) -> np.ndarray:
+    """(width / 2, width) blurred log-luminance of `panorama` resampled to `width` wide."""
+    image = np.asarray(panorama, dtype=np.float32)
+    image = resample_axis(resample_axis(image, width // 2, axis=0), width, axis=1)
+    return _blur(np.log(np.maximum(image @ _LUMINANCE.astype(np.float32), 1e-4)).astype(np.float64))
+
+
+@dataclass(frozen=True)
+class EdgeSamples:
+    """Samples along a reprojected edge, a pixel apart: their pixel coordinates (n, 2), unit
+    normals across the curve (n, 2), and the signed offset along the normal of the strongest
+    change of log-luminance (NaN where there is none)."""
+
+    points: np.ndarray
+    normals: np.ndarray
+    offsets: np.ndarray
+
+    def found(self) -> np.ndarray:
+        """(m, 2) where the photograph's edge is, at the samples that show one."""
+        ok = ~np.isnan(self.offsets)
+        return self.points[ok] + self.offsets[ok, None] * self.normals[ok]
+
+
+def edge_samples(log: np.ndarray, a: np.ndarray, b: np.ndarray, rotation: np.ndarray | None,
+                 search: float) -> EdgeSamples:
+    """Look for the photograph's edge across the reprojection of the segment a-b (probe frame)
+    within `search` pixels of `log` (from `log_luminance`)."""
     height, width = log.shape
     dense = project(a + np.linspace(0.0, 1.0, 2001)[:, None] * (b - a), width, height, rotation)
     steps = np.linalg.norm(pixel_offsets(dense[1:], dense[:-1], width), axis=1)
     along = np.concatenate([[0.0], np.cumsum(steps)])
     total = along[-1]
     if total < 2 * _END_GAP + 2:
-        return np.empty(0)
+        return EdgeSamples(np.empty((0, 2)), np.empty((0, 2)), np.empty(0))
     at = np.arange(_END_GAP, total - _END_GAP, 1.0)
     index = np.clip(np.searchsorted(along, at), 1, len(dense) - 1)
     points = dense[index]
@@ -86,14 +106,15 @@ def _edge_samples(log: np.ndarray, a: np.ndarray, b: np.ndarray, rotation: np.nd
     inside = np.abs(s) <= search
     change = np.where(inside[None, :], change, -1.0)
     best = np.argmax(change, axis=1)
-    strength = change[np.arange(len(best)), best]
+    rows = np.arange(len(best))
+    strength = change[rows, best]
     # Sub-sample peak by a parabola through the best sample and its neighbours.
-    lo, hi = change[np.arange(len(best)), best - 1], change[np.arange(len(best)), np.minimum(best + 1, len(s) - 1)]
+    lo, hi = change[rows, best - 1], change[rows, np.minimum(best + 1, len(s) - 1)]
     curvature = lo - 2 * strength + hi
     shift = np.where(curvature < 0, 0.5 * (lo - hi) / np.where(curvature < 0, curvature, 1.0), 0.0)
     offset = s[best] + np.clip(shift, -0.5, 0.5) * _STEP
     on_edge = (strength >= _CONTRAST) & (points[:, 1] > 1) & (points[:, 1] < height - 2)
-    return np.where(on_edge, offset, np.nan)
+    return EdgeSamples(points, normal, np.where(on_edge, offset, np.nan))
 
 
 def _bilinear(image: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:

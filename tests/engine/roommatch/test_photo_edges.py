@@ -8,6 +8,7 @@ import numpy as np
 from addon.roommatch.clicks import RoomClicks
 from addon.roommatch.fit import fit_room
 from addon.roommatch.photo_edges import edge_offsets
+from addon.roommatch.refine import refine_clicks
 from tests.engine.roommatch.room_truth import clicks_of, flat_panorama, floor_points
 
 BOX = np.array([(-2.0, -1.5), (3.0, -1.5), (3.0, 2.5), (-2.0, 2.5)])
@@ -33,3 +34,16 @@ def test_a_lower_ceiling_is_seen_off_its_edges() -> None:
     ceiling = found.offsets[4:8]
     assert not np.any(ceiling <= 2.0)  # off by more than 2 px, or no edge within the search at all
     assert np.all(found.offsets[:4] < 0.5)
+
+
+def test_refined_clicks_land_on_the_photograph_corners() -> None:
+    # Clicks a whole pixel off at 512 wide; the panorama twice as wide shows the edges.
+    width = 512
+    floor = clicks_of(floor_points(BOX), PROBE, width, width // 2) + np.array([[1, -1], [-1, 1], [1, 1], [-1, -1]])
+    clicks = RoomClicks(width, width // 2, tuple(map(tuple, floor)), camera_height=1.5)
+    room = fit_room(clicks, ceiling_height=2.6)
+    refined, shown = refine_clicks(flat_panorama(BOX, 2.6, PROBE, 2048, 1024), clicks, room)
+    assert shown.all()
+    before = np.abs(room.corners - BOX).max()
+    after = np.abs(fit_room(refined, ceiling_height=2.6).corners - BOX).max()
+    assert before > 0.05 and after < 0.01

@@ -1,0 +1,107 @@
+"""The command line's `room` command: Match Room from a click file, the batch route.
+
+    python -m addon.cli room [SCENE.blend] --clicks CLICKS.json --save OUT.blend --out DIR [options]
+    blender -b [SCENE.blend] -c dimred room --clicks CLICKS.json --save OUT.blend --out DIR [options]
+"""
+from __future__ import annotations
+
+import argparse
+import os
+
+import numpy as np
+
+from ..errors import DimredError
+
+_DESCRIPTION = """\
+Match Room: build the room's Floor, Walls and Ceiling from the floor corners clicked in the
+panorama (a click file, JSON; see below), set the probe centre where the camera was (the
+ProbeCenter Empty), and save the scene as OUT.blend (SCENE.blend itself is not changed; without
+it an empty scene, whose world shows --panorama). Writes into the output folder:
+
+  room.json             the room (corners, heights, wall lengths, the Manhattan turn), each
+                        corner's and floor edge's reprojection error (pixels), and how far each
+                        reprojected edge lies from the panorama's edges (pixels at 1024 wide)
+  room_diagnostics.png  the panorama with every edge of the room drawn over it (green floor,
+                        magenta ceiling, cyan corners; the clicks in yellow)
+
+A click file: {"width": W, "height": H, "floor": [[x, y], ...], "ceiling": [x, y],
+"camera_height": 1.6 | "known_length": {"kind": "wall", "edge": 0, "metres": 3.2} or
+{"kind": "vertical" | "floor", "from": [x, y], "to": [x, y], "metres": 2.0}, "manhattan": true}.
+Pixel coordinates are (column, row) on a W x H panorama, row 0 at the top, whole numbers at pixel
+centres; the floor corners in order round the room. Nothing is written when a click is bad."""
+
+
+def add_command(commands: argparse._SubParsersAction, *, formatter: type[argparse.HelpFormatter],
+                inside_blender: bool) -> None:
+    room = commands.add_parser("room", help="build Floor, Walls and Ceiling from clicks in the panorama (Match Room)",
+                               description=_DESCRIPTION, formatter_class=formatter)
+    room.add_argument("blend", nargs="?", metavar="SCENE.blend",
+                      help="the scene to add the room to (default: " + ("the open file" if inside_blender
+                                                                        else "an empty scene") + ")")
+    room.add_argument("--clicks", required=True, metavar="CLICKS.json", help="the click file")
+    room.add_argument("--save", required=True, metavar="OUT.blend", help="where to save the scene with the room")
+    room.add_argument("--out", required=True, metavar="DIR", help="output folder (created if needed)")
+    room.add_argument("--panorama", metavar="FILE", help="make the world show this HDR panorama (EXR, HDR)")
+    room.add_argument("--camera-height", type=float, metavar="M",
+                      help="the camera's height above the floor in metres (replaces the click file's)")
+    room.add_argument("--ceiling-height", type=float, default=None, metavar="M",
+                      help="the ceiling's height where the click file has no ceiling point (default 2.5)")
+    room.set_defaults(run=_room, inside_blender=inside_blender)
+
+
+def _room(args: argparse.Namespace) -> int:
+    import dataclasses
+
+    import bpy
+
+    from ..io import exr, outputs
+    from ..roommatch import clicks as click_file
+    from ..roommatch.diagnostics import room_picture
+    from ..roommatch.fit import DEFAULT_CEILING_HEIGHT
+    from ..roommatch.photo_edges import edge_offsets
+    from . import reader, room_builder
+    from .blend_file import open_blend
+
+    try:
+        with open(args.clicks, encoding="utf-8") as handle:
+            clicks = click_file.from_json(handle.read())
+    except OSError as error:
+        raise DimredError(f"cannot read the click file {args.clicks}: {error.strerror}") from None
+    if args.camera_height is not None:
+        clicks = dataclasses.replace(clicks, camera_height=args.camera_height, known_length=None)
+    save = os.path.abspath(args.save)
+    if not os.path.isdir(os.path.dirname(save)):
+        raise DimredError(f"no folder to save {save} in")
+    if args.blend:
+        open_blend(args.blend)
+    elif not args.inside_blender:
+        bpy.ops.wm.read_factory_settings(use_empty=True)
+    scene = bpy.context.scene
+    if args.panorama:
+        room_builder.show_panorama(scene, os.path.abspath(args.panorama))
+    ceiling = DEFAULT_CEILING_HEIGHT if args.ceiling_height is None else args.ceiling_height
+    room = room_builder.match_room(scene, clicks, ceiling_height=ceiling)
+    if hasattr(scene, "dimred_room"):  # the add-on is registered: its panel shows the clicks
+        scene.dimred_room.load(clicks)
+        scene.dimred_room.matched = True
+    report = {"room": room.summary(), "clicks": clicks.to_dict()}
+    writers = {}
+    try:
+        panorama = reader.panorama_pixels(scene)
+    except DimredError as error:
+        report["diagnostics"] = f"no room_diagnostics.png: {error}"
+    else:
+        rotation = room_builder.panorama_rotation(scene)
+        report["photo_edges"] = edge_offsets(panorama, room, rotation=rotation).summary()
+        picture = room_picture(panorama, room, clicks, rotation=rotation)
+        writers["room_diagnostics.png"] = lambda path: exr.write_png(path, picture)
+    writers["room.json"] = outputs.json_writer(report)
+    outputs.write_files(args.out, writers, stale=("room_diagnostics.png",))
+    try:
+        bpy.ops.wm.save_as_mainfile(filepath=save, copy=True)
+    except RuntimeError as error:
+        raise DimredError(f"cannot save {save}: {str(error).strip()}") from None
+    worst = float(np.max(room.corner_errors))
+    print(f"room: {len(clicks.floor)} corners, camera {room.camera_height:.3f} m, ceiling {room.ceiling_height:.3f} m, "
+          f"corners within {worst:.2f} px; saved {save}, wrote {args.out}", flush=True)
+    return 0
