@@ -1,5 +1,5 @@
 """Crops of ground-truth scenes where the object stood: before | truth | ours | ours per-pixel |
-PatchMatch, for the README (docs/images/fill_<scene>.png).
+PatchMatch, for docs/design.md (docs/images/fill_<scene>.png).
 
 Two steps, because PatchMatch lives in the benchmark environment and the removal in Blender's:
     .venv/bin/python benchmarks/fill_crops.py ours demo,basic_box,stool      (renders if not cached)

@@ -9,12 +9,27 @@ runs, which must show that the engine works without it. Tests import the extensi
 as `diminished_reality` (tests/blender/conftest.py); the root package has no module-level
 setup, so its setup is skipped.
 
+The order of the modules follows tests/durations.json, each module's seconds measured in a
+whole run (`./dev durations`, that is pytest with --write-durations): the longest first.
+
 Fixtures live next to the tests that use them: tests/blender/conftest.py (Blender sessions, the
 extension, the tiny room in Blender) and tests/engine/conftest.py (engine runs without bpy).
 """
 from __future__ import annotations
 
+import json
+from collections import defaultdict
+from pathlib import Path
+
 import pytest
+
+#: Each test module's seconds in a whole run of the suite (`./dev durations` writes it).
+DURATIONS = Path(__file__).resolve().parent / "durations.json"
+
+
+def pytest_addoption(parser: pytest.Parser) -> None:
+    parser.addoption("--write-durations", metavar="PATH", type=Path,
+                     help="write each test module's seconds (setup, call and teardown summed) to PATH as JSON")
 
 
 def _skip_setup() -> None:
@@ -27,16 +42,42 @@ def pytest_collection_modifyitems(session: pytest.Session, config: pytest.Config
             node.setup = _skip_setup
     # `./dev test` hands whole modules to two workers as they come free (pytest-xdist,
     # --dist loadfile): the longest first, or one started last would leave the other worker
-    # idle for minutes. Each module's tests stay together and in their order.
+    # idle for minutes. Each module's tests stay together and in their order (the sort is stable).
+    seconds = _module_seconds(items, config.rootpath, _measured())
+    items.sort(key=lambda item: -seconds[item.path])
+
+
+def _measured() -> dict[str, float]:
+    return json.loads(DURATIONS.read_text())["modules"] if DURATIONS.exists() else {}
+
+
+def _module_seconds(items: list[pytest.Item], root: Path, measured: dict[str, float]) -> dict[Path, float]:
+    """Each collected module's expected seconds: its measured ones (`measured`, by path relative to
+    `root`). A module not measured yet counts as the longest measured one when it holds a test
+    marked slow (it may render minutes), else as 0."""
     slow = {item.path for item in items if item.get_closest_marker("slow")}
-    items.sort(key=lambda item: (_rank(item.path.stem), item.path not in slow))
+    longest = max(measured.values(), default=0.0)
+    return {path: measured.get(path.relative_to(root).as_posix(), longest if path in slow else 0.0)
+            for path in {item.path for item in items}}
 
 
-# The modules that take minutes on two cores from a clean clone (their renders included), longest
-# first; then every module with a slow test, then the rest, in collection order.
-_LONGEST = ("test_relocation_groundtruth", "test_rough_proxy_groundtruth", "test_batch_groundtruth",
-            "test_full_resolution_groundtruth", "test_removal_groundtruth")
+class DurationRecorder:
+    """Sums the seconds of every test phase per module and writes them when the session ends
+    (on the controller only, under xdist: the workers' reports reach it)."""
+
+    def __init__(self, path: Path) -> None:
+        self.path = path
+        self.seconds: defaultdict[str, float] = defaultdict(float)
+
+    def pytest_runtest_logreport(self, report: pytest.TestReport) -> None:
+        self.seconds[report.nodeid.split("::")[0]] += report.duration
+
+    def pytest_sessionfinish(self, session: pytest.Session) -> None:
+        ordered = dict(sorted(((m, round(s, 1)) for m, s in self.seconds.items()), key=lambda kv: -kv[1]))
+        self.path.write_text(json.dumps({"modules": ordered}, indent=1) + "\n")
 
 
-def _rank(module: str) -> int:
-    return _LONGEST.index(module) if module in _LONGEST else len(_LONGEST)
+def pytest_configure(config: pytest.Config) -> None:
+    path = config.getoption("--write-durations")
+    if path is not None and not hasattr(config, "workerinput"):
+        config.pluginmanager.register(DurationRecorder(path), "dimred-durations")

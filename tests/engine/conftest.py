@@ -1,4 +1,5 @@
-"""When only engine tests run (`pytest tests/engine`), Blender's modules cannot be imported.
+"""When only engine tests run (`pytest tests/engine`, `./dev test --quick`), Blender's modules
+and the Cycles renderer of the ground truths (`scenes.render`) cannot be imported.
 
 The engine is numpy-only so that it runs outside Blender (the command line's worker, CI without
 Blender); an engine test that needs bpy, even indirectly through a helper, would hide a
@@ -15,13 +16,15 @@ import pytest
 
 ENGINE_TESTS = Path(__file__).resolve().parent
 BLENDER_MODULES = ("bpy", "bmesh", "mathutils", "bl_math", "bl_ui", "bl_operators", "bpy_extras", "gpu")
+# Renders belong to the ground-truth tests: the engine's tier stays free of Cycles' minutes.
+RENDERERS = ("scenes.render", "scenes.render_job")
 
 
 class NoBlender(importlib.abc.MetaPathFinder):
-    """Refuses Blender's modules, so that importing one fails the test that tried."""
+    """Refuses Blender's modules and the renderer, so that importing one fails the test that tried."""
 
     def find_spec(self, fullname: str, path=None, target=None):
-        if fullname.split(".")[0] in BLENDER_MODULES:
+        if fullname.split(".")[0] in BLENDER_MODULES or fullname in RENDERERS:
             raise ImportError(f"engine tests run without Blender: '{fullname}' may not be imported")
         return None
 
