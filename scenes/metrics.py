@@ -295,3 +295,21 @@ def ring_error(input: np.ndarray, edited: np.ndarray, truth: np.ndarray, silhoue
         return np.abs(box_blur3(np.where(ring, luminance(image) - y_truth, 0.0))[ring] / weight)
 
     return float(local_error(edited).sum() / local_error(input).sum())
+
+
+def bruise_share(edit: np.ndarray, truth: np.ndarray, object_mask: np.ndarray, *, width_px: int | None = None,
+                 factor: float = 0.8, percentile: float = 1.0) -> float:
+    """Share of the object's pixels (the hidden region) that the edit fills darker than anything
+    the clean surface there shows: blurred Y_edit below `factor` times the `percentile` of the
+    truth's blurred Y over the object's pixels and `width_px` px around them (default W/64, at
+    least 4). A fill that copies a chair's dark legs, a rug's black stripes or the object's own
+    contact shadow into a light floor leaves such a bruise; render noise does not (the blur, and
+    the percentile of the truth's own noisy pixels). Raises ValueError if the mask is empty."""
+    mask = np.asarray(object_mask, dtype=bool)
+    if not mask.any():
+        raise ValueError("the object mask is empty")
+    if width_px is None:
+        width_px = max(4, mask.shape[1] // 64)
+    surface = _blurred_y(truth)[dilate(mask, width_px)]
+    darkest = factor * float(np.percentile(surface, percentile))
+    return float((_blurred_y(edit)[mask] < darkest).mean())

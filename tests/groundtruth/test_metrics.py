@@ -192,3 +192,24 @@ def test_relit_detail_ratio_sees_a_shadow_relit_with_its_noise() -> None:
     assert M.relit_detail_ratio(noisy, truth, truth, mask)[0] == pytest.approx(1.0)
     with pytest.raises(ValueError, match="brighter"):
         M.relit_detail_ratio(truth, truth, truth, mask)
+
+
+def test_bruise_share_counts_fill_pixels_darker_than_the_clean_surface() -> None:
+    rng = np.random.default_rng(3)
+    truth = (0.5 + 0.02 * rng.standard_normal((H, W, 3))).clip(0.1)
+    mask = np.zeros((H, W), bool)
+    mask[8:16, 8:20] = True  # 96 pixels
+    assert M.bruise_share(truth, truth, mask) == 0.0
+    # A 2 x 12 dark stripe copied into the fill: its 24 pixels, and the 3x3 blur's row either side
+    # of it, where a third of the window is dark (0.35 < 0.8 x 0.47), less their ends (two ninths).
+    edit = truth.copy()
+    edit[11:13, 8:20] = 0.05
+    assert M.bruise_share(edit, truth, mask) == pytest.approx((24 + 2 * 10) / 96)
+    # 15 % darker everywhere is a mismatch of brightness, not a bruise.
+    assert M.bruise_share(truth * 0.85, truth, mask) == 0.0
+    # The same stripe is no bruise where the clean surface shows as dark a stripe nearby.
+    striped = truth.copy()
+    striped[4:6, 2:30] = 0.05
+    assert M.bruise_share(edit, striped, mask) == 0.0
+    with pytest.raises(ValueError, match="empty"):
+        M.bruise_share(truth, truth, np.zeros((H, W), bool))
