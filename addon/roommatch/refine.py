@@ -20,9 +20,9 @@ from .fit import RoomFit
 from .photo_edges import edge_samples, log_luminance
 from .projection import click_directions, project
 
-# Pixels at the working width, round by round: the first also reaches three of the clicks' pixels.
-_SEARCHES = (6.0, 3.0, 2.0)
-_CLICK_REACH = 3.0
+# How far the photograph's edge is looked for, round by round, in pixels of the clicks (a click
+# is good to a pixel or two; farther, a window's frame or a skirting board would be taken).
+_SEARCHES = (3.0, 2.0, 1.5)
 _MIN_SHOWN = 0.3  # share of an edge's samples that must find the photograph's edge
 _MIN_POINTS = 12
 _MIN_ANGLE = np.radians(10.0)  # walls closer to parallel than this do not make a corner
@@ -37,8 +37,7 @@ def refine_clicks(panorama: np.ndarray, clicks: RoomClicks, room: RoomFit, *, ro
     log = log_luminance(panorama, width)
     unit = (room.corners - room.probe[:2]) / room.camera_height
     shown = np.zeros(len(unit), dtype=bool)
-    searches = (max(_SEARCHES[0], _CLICK_REACH * width / clicks.width), *_SEARCHES[1:])
-    for search in searches:
+    for search in np.array(_SEARCHES) * max(1.0, width / clicks.width):
         lines = [_wall_line(log, a, b, rotation, search) for a, b in zip(unit, np.roll(unit, -1, axis=0), strict=True)]
         shown = np.array([line is not None for line in lines])
         unit = np.array([_corner(unit[i], lines[i - 1], lines[i]) for i in range(len(unit))])
