@@ -13,20 +13,23 @@ from __future__ import annotations
 import numpy as np
 
 from ..light.radiosity import LUMA
-from ..segmentation.masks import box_mean, dilate
+from ..segmentation.masks import box_mean, dilate, rect_sum
 
 # A boundary pixel's step is measured over the band within this share of the filled region's
 # extent around it (in pixels, within the bounds), each side's band half as deep: wide enough
 # that a texture's tiles, planks and grain average out on both sides.
 _REACH, _MIN_REACH, _MAX_REACH = 1 / 3, 4, 24
-# A texture's own local means vary from place to place (a tile or a plank more in one band, the
-# gap between them in the other), and a fill continuing it right still differs from the other
-# side by as much. So a step is taken only as far as it stands out of how much the surface's
-# local means vary around the hole (beyond `_SIGNIFICANCE` times their spread), and averaged
-# along the boundary over twice the reach.
+# A texture's local means differ between two bands by themselves (a tile or a plank more in one,
+# the gap between them in the other), and so does the light across a lit floor: a fill continuing
+# both right still differs from the other side by as much. So a step is taken only as far as it
+# stands out of the steps the surface around the hole shows between squares as far apart
+# (beyond `_SIGNIFICANCE` times their spread), and averaged along the boundary over twice the reach.
 _ALONG = 2
-_SIGNIFICANCE = 2.0
-_AROUND = 4  # reaches: the surface around the hole whose local means give their spread
+_SIGNIFICANCE = 1.0
+# A texture's steps are rare but large (most pairs of strips lie within one tile): a high
+# quantile of them, not their median, is what a boundary may show by chance.
+_STEP_QUANTILE = 0.9
+_AROUND = 2  # reaches: the surface around the hole whose own steps are measured
 def seamless_change(radiance: np.ndarray, change: np.ndarray, filled: np.ndarray, surface: np.ndarray
                     ) -> np.ndarray:
     """(h, w, 3) `change` with the `filled` pixels' (h, w) step against the rest taken out, per
@@ -51,7 +54,7 @@ def seamless_change(radiance: np.ndarray, change: np.ndarray, filled: np.ndarray
         boundary = inside & dilate(outside, 1) & (n_out > 0) & (n_in > 0)
         if not boundary.any():
             continue
-        spread = _local_spread(edited, outside & dilate(inside, _AROUND * reach), reach)
+        spread = _step_spread(edited, outside & dilate(inside, _AROUND * reach), reach, band)
         step, _ = box_mean(np.where(boundary[..., None], m_out - m_in, 0.0), boundary, _ALONG * reach)
         kept = np.clip(1 - (_SIGNIFICANCE * spread / np.maximum(np.abs(step @ LUMA), 1e-30)) ** 2, 0.0, 1.0)
         membrane = _pull_push(np.where(boundary[..., None], step * kept[..., None], 0.0), boundary)
@@ -60,14 +63,30 @@ def seamless_change(radiance: np.ndarray, change: np.ndarray, filled: np.ndarray
     return out
 
 
-def _local_spread(edited: np.ndarray, around: np.ndarray, radius: int) -> float:
-    """The spread (standard deviation) of the luminance's local means over squares of `radius`
-    lying mostly on the pixels `around`; infinite where too few such squares are there."""
-    mean, count = box_mean(edited @ LUMA[:, None], around, radius)
-    full = around & (count >= 0.5 * (2 * radius + 1) ** 2)
-    if full.sum() < 2 * radius:
+def _step_spread(edited: np.ndarray, around: np.ndarray, reach: int, band: int) -> float:
+    """How much the luminance's means over two adjacent strips `band` deep and `2 reach + 1`
+    long (across or along the rows) differ where both lie mostly on the pixels `around`: the
+    steps the surface shows by itself between bands like the boundary's, its light and texture.
+    A high quantile, robust to a desk or a rug beside the hole being a minority of the pairs;
+    infinite where too few such pairs are there."""
+    luma = (edited @ LUMA) * around
+    half = band // 2
+    apart = 2 * half + 1
+    steps = []
+    for sizes in ((half, reach), (reach, half)):
+        total, count = rect_sum(luma, *sizes), rect_sum(around.astype(np.float64), *sizes)
+        full = count >= 0.5 * (2 * sizes[0] + 1) * (2 * sizes[1] + 1)
+        mean = total / np.maximum(count, 1e-12)
+        axis = 0 if sizes[0] == half else 1
+        first = [slice(None), slice(None)]
+        second = [slice(None), slice(None)]
+        first[axis], second[axis] = slice(None, -apart), slice(apart, None)
+        both = full[tuple(first)] & full[tuple(second)]
+        steps.append(mean[tuple(first)][both] - mean[tuple(second)][both])
+    step = np.concatenate(steps)
+    if len(step) < 2 * reach:
         return float("inf")
-    return float(mean[full, 0].std())
+    return float(np.quantile(np.abs(step - np.median(step)), _STEP_QUANTILE))
 
 
 def _pull_push(values: np.ndarray, known: np.ndarray) -> np.ndarray:

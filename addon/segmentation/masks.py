@@ -8,11 +8,18 @@ import numpy as np
 def box_sum(a: np.ndarray, radius: int) -> np.ndarray:
     """Sums of `a` ((h, w) or (h, w, c)) over the (2 radius + 1)^2 square around each pixel,
     zero past the edges; float64 for float input, int64 for bool or int."""
+    return rect_sum(a, radius, radius)
+
+
+def rect_sum(a: np.ndarray, rows: int, cols: int) -> np.ndarray:
+    """Sums of `a` ((h, w) or (h, w, c)) over the (2 rows + 1) x (2 cols + 1) rectangle around
+    each pixel, zero past the edges; float64 for float input, int64 for bool or int."""
     dtype = np.float64 if np.issubdtype(a.dtype, np.floating) else np.int64
     out = np.asarray(a, dtype=dtype)
-    if radius <= 0:
-        return out.copy()
-    for axis in (0, 1):
+    for axis, radius in ((0, rows), (1, cols)):
+        if radius <= 0:
+            out = out.copy()
+            continue
         m = np.moveaxis(out, axis, 0)
         n = len(m)
         zeros = np.zeros((radius + 1, *m.shape[1:]), dtype=dtype)
