@@ -11,7 +11,7 @@ from __future__ import annotations
 import json
 
 import bpy
-from bpy.props import EnumProperty, FloatProperty, IntProperty, StringProperty
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty
 
 from ..addon.errors import DimredError
 from .support import pictures
@@ -42,27 +42,39 @@ def add_click(scene: bpy.types.Scene, kind: str, x: float, y: float) -> str:
     return f"known length's {'start' if kind == 'LENGTH_START' else 'end'} at ({x:.1f}, {y:.1f})"
 
 
-def match(scene: bpy.types.Scene) -> str:
-    """Fit and build the room from the scene's clicks; the summary line. DimredError: nothing changed."""
+def match(scene: bpy.types.Scene, *, snap: bool = False) -> str:
+    """Fit and build the room from the scene's clicks (with `snap`, first moved onto the
+    photograph's wall-floor edges); the summary line. DimredError: nothing changed."""
     from ..addon.blender import reader, room_builder
     from ..addon.roommatch.diagnostics import room_picture
+    from ..addon.roommatch.fit import fit_room
+    from ..addon.roommatch.refine import refine_clicks
 
     room = scene.dimred_room
     clicks = room.clicks()
-    fitted = room_builder.match_room(scene, clicks, ceiling_height=room.ceiling_height)
-    room.matched, room.problem = True, ""
-    room.summary = json.dumps(fitted.summary())
+    rotation = room_builder.panorama_rotation(scene)
     try:
         panorama = reader.panorama_pixels(scene)
     except DimredError:
+        if snap:
+            raise
         panorama = None  # no panorama in the world: the room stands, there is nothing to draw it over
+    snapped = ""
+    if snap:
+        first = fit_room(clicks, rotation=rotation, ceiling_height=room.ceiling_height)
+        clicks, shown = refine_clicks(panorama, clicks, first, rotation=rotation)
+        snapped = f", {int(shown.sum())} of {len(shown)} walls snapped to the photograph"
+    fitted = room_builder.match_room(scene, clicks, ceiling_height=room.ceiling_height)
+    if snap:
+        room.load(clicks)
+    room.matched, room.problem = True, ""
+    room.summary = json.dumps(fitted.summary())
     if panorama is not None:
-        picture = pictures.Picture.of(room_picture(panorama, fitted, clicks,
-                                                   rotation=room_builder.panorama_rotation(scene)))
+        picture = pictures.Picture.of(room_picture(panorama, fitted, clicks, rotation=rotation))
         pictures.show_diagnostics(picture, ROOM_DIAGNOSTICS_IMAGE)
     return (f"Room matched: {len(clicks.floor)} corners, camera {fitted.camera_height:.2f} m "
             f"({fitted.scale_source}), ceiling {fitted.ceiling_height:.2f} m, "
-            f"corners within {fitted.corner_errors.max():.2f} px of their clicks")
+            f"corners within {fitted.corner_errors.max():.2f} px of their clicks{snapped}")
 
 
 class DIMRED_OT_match_room(bpy.types.Operator):
@@ -72,9 +84,13 @@ class DIMRED_OT_match_room(bpy.types.Operator):
                       "known length), and set the probe centre where the camera was")
     bl_options = {'REGISTER', 'UNDO'}
 
+    snap: BoolProperty(name="Snap to Photo", description=(
+        "First move the floor corners onto the wall-floor edges the photograph shows near them (each wall's "
+        "foot fitted along its whole length); walls the photograph hides keep their clicks"))
+
     def execute(self, context: bpy.types.Context) -> set[str]:
         try:
-            message = match(context.scene)
+            message = match(context.scene, snap=self.snap)
         except DimredError as error:
             self.report({'ERROR'}, str(error))
             return {'CANCELLED'}

@@ -49,7 +49,9 @@ class DIMRED_PT_room(bpy.types.Panel):
             row.prop(room, "ceiling", text="")
         else:
             row.prop(room, "ceiling_height")
-        layout.operator("dimred.match_room", icon='MESH_CUBE')
+        row = layout.row(align=True)
+        row.operator("dimred.match_room", icon='MESH_CUBE')
+        row.operator("dimred.match_room", text="Snap to Photo", icon='SNAP_ON').snap = True
         if room.problem:
             layout.label(text=room.problem, icon='ERROR')
         _fit(layout, room.summary)

@@ -46,6 +46,9 @@ def add_command(commands: argparse._SubParsersAction, *, formatter: type[argpars
                       help="the camera's height above the floor in metres (replaces the click file's)")
     room.add_argument("--ceiling-height", type=float, default=None, metavar="M",
                       help="the ceiling's height where the click file has no ceiling point (default 2.5)")
+    room.add_argument("--snap", action="store_true",
+                      help="first move the floor corners onto the wall-floor edges the panorama shows near them "
+                           "(walls it hides keep their clicks); room.json keeps the clicks as given")
     room.set_defaults(run=_room, inside_blender=inside_blender)
 
 
@@ -57,8 +60,9 @@ def _room(args: argparse.Namespace) -> int:
     from ..io import exr, outputs
     from ..roommatch import clicks as click_file
     from ..roommatch.diagnostics import room_picture
-    from ..roommatch.fit import DEFAULT_CEILING_HEIGHT
+    from ..roommatch.fit import DEFAULT_CEILING_HEIGHT, fit_room
     from ..roommatch.photo_edges import edge_offsets
+    from ..roommatch.refine import refine_clicks
     from . import reader, room_builder
     from .blend_file import open_blend
 
@@ -80,18 +84,28 @@ def _room(args: argparse.Namespace) -> int:
     if args.panorama:
         room_builder.show_panorama(scene, os.path.abspath(args.panorama))
     ceiling = DEFAULT_CEILING_HEIGHT if args.ceiling_height is None else args.ceiling_height
+    rotation = room_builder.panorama_rotation(scene)
+    try:
+        panorama, missing = reader.panorama_pixels(scene), ""
+    except DimredError as error:
+        if args.snap:
+            raise
+        panorama, missing = None, str(error)
+    report = {}
+    if args.snap:
+        clicked = clicks
+        clicks, shown = refine_clicks(panorama, clicks, fit_room(clicks, rotation=rotation, ceiling_height=ceiling),
+                                      rotation=rotation)
+        report["snapped"] = {"clicked": clicked.to_dict()["floor"], "walls_snapped": shown.tolist()}
     room = room_builder.match_room(scene, clicks, ceiling_height=ceiling)
     if hasattr(scene, "dimred_room"):  # the add-on is registered: its panel shows the clicks
         scene.dimred_room.load(clicks)
         scene.dimred_room.matched = True
-    report = {"room": room.summary(), "clicks": clicks.to_dict()}
+    report.update(room=room.summary(), clicks=clicks.to_dict())
     writers = {}
-    try:
-        panorama = reader.panorama_pixels(scene)
-    except DimredError as error:
-        report["diagnostics"] = f"no room_diagnostics.png: {error}"
+    if panorama is None:
+        report["diagnostics"] = f"no room_diagnostics.png: {missing}"
     else:
-        rotation = room_builder.panorama_rotation(scene)
         report["photo_edges"] = edge_offsets(panorama, room, rotation=rotation).summary()
         picture = room_picture(panorama, room, clicks, rotation=rotation)
         writers["room_diagnostics.png"] = lambda path: exr.write_png(path, picture)
@@ -102,6 +116,6 @@ def _room(args: argparse.Namespace) -> int:
     except RuntimeError as error:
         raise DimredError(f"cannot save {save}: {str(error).strip()}") from None
     worst = float(np.max(room.corner_errors))
-    print(f"room: {len(clicks.floor)} corners, camera {room.camera_height:.3f} m, ceiling {room.ceiling_height:.3f} m, "
+    print(f"dimred: matched the room: {len(clicks.floor)} corners, camera {room.camera_height:.3f} m, ceiling {room.ceiling_height:.3f} m, "
           f"corners within {worst:.2f} px; saved {save}, wrote {args.out}", flush=True)
     return 0

@@ -110,3 +110,19 @@ def test_click_files_load_and_save(panorama_room: np.ndarray, tmp_path: Path) ->
     assert len(bpy.context.scene.dimred_room.corners) == 0
     bpy.ops.dimred.room_load_clicks(filepath=str(tmp_path / "clicks.json"))
     assert [tuple(c.point) for c in bpy.context.scene.dimred_room.corners] == [tuple(p) for p in panorama_room]
+
+
+def test_snap_to_photo_moves_the_clicks_onto_the_walls(panorama_room: np.ndarray) -> None:
+    scene = bpy.context.scene
+    _click_all(panorama_room + np.array([[1, -1], [-1, 1], [1, 1], [-1, -1]]))  # each a pixel or two off
+    scene.dimred_room.camera_height = 1.5
+    bpy.ops.dimred.match_room()
+    before = _vertices("Floor")[:, :2]
+    assert bpy.ops.dimred.match_room(snap=True) == {'FINISHED'}
+    after = _vertices("Floor")[:, :2]
+
+    def error(found: np.ndarray) -> float:
+        return float(max(np.min(np.linalg.norm(found - c, axis=1)) for c in BOX))
+
+    assert error(after) < 0.5 * error(before)
+    assert [tuple(c.point) for c in scene.dimred_room.corners] != [tuple(p) for p in panorama_room]
