@@ -52,3 +52,14 @@ def _wall_hit(c: np.ndarray, a: np.ndarray, reach: float) -> int:
     t = np.sum((p - c) * e, axis=1) / np.sum(e * e, axis=1)
     gap = np.linalg.norm(c + np.clip(t, 0, 1)[:, None] * e - p, axis=1)
     return int(np.argmin(gap))
+
+
+def with_box(panorama: np.ndarray, params: np.ndarray, camera: float, colour: tuple[float, float, float]) -> np.ndarray:
+    """`panorama` with a box (`object_box.silhouette`'s parameters) painted flat in `colour`."""
+    from addon.geometry.latlong import pixel_directions
+    from addon.roommatch.object_box import silhouette
+
+    height, width = panorama.shape[:2]
+    out = panorama.copy()
+    out[silhouette(np.asarray(params, dtype=np.float64), pixel_directions(width, height), camera)] = colour
+    return out
