@@ -24,7 +24,8 @@ from .projection import click_directions
 _WORKING_WIDTH = 1024
 _WINDOW = 0.12  # half the window's side, as a share of the panorama's width (43 degrees)
 _REFINE_BAND = 0.12  # the second pass's band, as a share of the object's size in pixels
-_SEED = 2  # px radius of the seed disc at the click
+_SEED = 1.5  # px radius of the seed disc at the click, on the coarsest copy the segmentation halves to
+_COARSEST_BAND = 16  # the widest band `segment_object` decides without halving
 _MIN_PIXELS = 30
 _STEPS = np.array([0.05, 0.05, 0.1, 0.1, 0.1, np.radians(5.0)])  # metres, log-size, radians
 _FINEST = 1.0 / 32.0  # of the first steps
@@ -79,8 +80,11 @@ def box_from_click(panorama: np.ndarray, click: tuple[float, float], *, click_si
     # Pixel directions in the probe's frame, the window's columns as the panorama's.
     directions = click_directions(np.stack(np.broadcast_arrays(cols[None, :], rows[:, None]), axis=-1),
                                   width, height, rotation)
-    seed = (rows[:, None] - y) ** 2 + (cols[None, :] - x) ** 2 <= _SEED**2
-    shown = _segment(window, seed, half)
+    band = half // 2
+    # The segmentation decides a wide band on halved copies first: the seed must survive them.
+    halvings = max(0, int(np.ceil(np.log2(band / _COARSEST_BAND))))
+    seed = (rows[:, None] - y) ** 2 + (cols[None, :] - x) ** 2 <= (_SEED * 2**halvings) ** 2
+    shown = _segment(window, seed, band)
     points = _floor_points(shown, directions, camera)
     if len(points) < 3:
         raise DimredError(f"no object standing on the floor is seen at ({click[0]:g}, {click[1]:g}): click inside "
@@ -111,12 +115,13 @@ def silhouette(params: np.ndarray, directions: np.ndarray, camera: float) -> np.
     return far >= np.maximum(near, 0.0)
 
 
-def _segment(window: np.ndarray, seed: np.ndarray, half: int) -> np.ndarray:
-    """The object at the seed: segmented in a band half the window wide around the seed (its
-    background sampled beyond that band), then again in a narrow band around what was found."""
+def _segment(window: np.ndarray, seed: np.ndarray, band: int) -> np.ndarray:
+    """The object at the seed: segmented in a `band` half the window wide around the seed (its
+    background sampled beyond that band; no pull towards the seed's side, which would keep the
+    object as small as the seed), then again in a narrow band around what was found."""
     if float(np.ptp(window)) <= 1e-6 * max(float(window.max()), 1e-12):
         raise DimredError("the panorama is flat around the click: there is no object to outline")
-    part = _holding(segment_object(window, seed, band=max(1, half // 2 - _SEED)).object, seed)
+    part = _holding(segment_object(window, seed, band=band, prior=0.0).object, seed)
     if part.sum() >= _MIN_PIXELS:
         extent = max(np.ptp(np.nonzero(part)[0]), np.ptp(np.nonzero(part)[1]))
         part = _holding(segment_object(window, part, band=max(2, int(_REFINE_BAND * extent))).object, seed)
