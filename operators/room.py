@@ -11,6 +11,7 @@ from __future__ import annotations
 import json
 
 import bpy
+import numpy as np
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty
 
 from ..addon.errors import DimredError
@@ -160,6 +161,53 @@ class DIMRED_OT_room_click(bpy.types.Operator):
         return {'PASS_THROUGH'}
 
 
+class DIMRED_OT_object_from_photo(bpy.types.Operator):
+    bl_idname = "dimred.object_from_photo"
+    bl_label = "Object from Photo"
+    bl_description = ("Click inside an object standing on the floor in the Image Editor showing the panorama: a box "
+                      "proxy is fitted to its outline (place, width, depth, height, turn) and marked for removal")
+    bl_options = {'REGISTER', 'UNDO'}
+
+    x: FloatProperty(name="Column", description="Pixels from the left, pixel centres at whole numbers")
+    y: FloatProperty(name="Row", description="Pixels from the top, pixel centres at whole numbers")
+    width: IntProperty(name="Width", description="The panorama's width the click was made on (0: the world's)", min=0)
+    height: IntProperty(name="Height", description="The panorama's height the click was made on (0: the world's)",
+                        min=0)
+    name: StringProperty(name="Name", description="The new proxy's name", default="Object")
+
+    def execute(self, context: bpy.types.Context) -> set[str]:
+        from ..addon.blender import reader, room_builder
+        from ..addon.roommatch.object_box import box_from_click
+
+        scene = context.scene
+        try:
+            size = (self.width, self.height) if self.width and self.height else _world_size(scene)
+            if size is None:
+                raise DimredError("the world shows no panorama: add an Environment Texture with the HDRI")
+            box = box_from_click(reader.panorama_pixels(scene), (self.x, self.y), click_size=size,
+                                 probe=reader.probe_center(scene), floor_z=room_builder.floor_height(scene),
+                                 rotation=room_builder.panorama_rotation(scene))
+        except DimredError as error:
+            self.report({'ERROR'}, str(error))
+            return {'CANCELLED'}
+        obj = room_builder.box_object(scene, self.name, box.corners())
+        scene.dimred.mark(obj)
+        width, depth, tall = box.size
+        self.report({'INFO'}, f"'{obj.name}': {width:.2f} × {depth:.2f} × {tall:.2f} m, turned "
+                              f"{np.degrees(box.turn):.1f}°, {100 * box.agreement:.0f} % of the outline agrees")
+        return {'FINISHED'}
+
+    def invoke(self, context: bpy.types.Context, event: bpy.types.Event) -> set[str]:
+        space = context.space_data
+        if context.area is None or context.area.type != 'IMAGE_EDITOR' or space.image is None:
+            self.report({'ERROR'}, "show the panorama in an Image Editor and click the object there")
+            return {'CANCELLED'}
+        u, v = context.region.view2d.region_to_view(event.mouse_region_x, event.mouse_region_y)
+        self.width, self.height = space.image.size
+        self.x, self.y = u * self.width - 0.5, (1.0 - v) * self.height - 0.5
+        return self.execute(context)
+
+
 class DIMRED_OT_room_remove_corner(bpy.types.Operator):
     bl_idname = "dimred.room_remove_corner"
     bl_label = "Remove Corner"
@@ -285,7 +333,8 @@ def _world_size(scene: bpy.types.Scene) -> tuple[int, int] | None:
         return None
 
 
-classes = (DIMRED_OT_match_room, DIMRED_OT_room_click, DIMRED_OT_room_remove_corner, DIMRED_OT_room_clear,
-           DIMRED_OT_room_load_clicks, DIMRED_OT_room_save_clicks, DIMRED_OT_show_room_diagnostics)
+classes = (DIMRED_OT_match_room, DIMRED_OT_room_click, DIMRED_OT_object_from_photo, DIMRED_OT_room_remove_corner,
+           DIMRED_OT_room_clear, DIMRED_OT_room_load_clicks, DIMRED_OT_room_save_clicks,
+           DIMRED_OT_show_room_diagnostics)
 
 register, unregister = bpy.utils.register_classes_factory(classes)

@@ -92,6 +92,26 @@ def show_panorama(scene: bpy.types.Scene, path: str) -> None:
     scene.world = world
 
 
+def floor_height(scene: bpy.types.Scene) -> float:
+    """The z of the Floor object's lowest vertex, 0 where the scene has no Floor mesh."""
+    floor = scene.objects.get("Floor")
+    if floor is None or floor.type != 'MESH' or not len(floor.data.vertices):
+        return 0.0
+    return float(min((floor.matrix_world @ v.co).z for v in floor.data.vertices))
+
+
+def box_object(scene: bpy.types.Scene, name: str, corners: np.ndarray) -> bpy.types.Object:
+    """A new box mesh object `name` (or `name`.001 ...) with the 8 `corners` (bottom four counter-
+    clockwise, then the top four), its faces' normals outwards."""
+    faces = ((0, 3, 2, 1), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7))
+    mesh = bpy.data.meshes.new(name)
+    mesh.from_pydata([tuple(v) for v in np.asarray(corners, dtype=np.float64).tolist()], [], faces)
+    mesh.validate()
+    obj = bpy.data.objects.new(name, mesh)
+    scene.collection.objects.link(obj)
+    return obj
+
+
 def _put_mesh(scene: bpy.types.Scene, data: MeshData) -> bpy.types.Object:
     mesh = bpy.data.meshes.new(data.name)
     mesh.from_pydata([tuple(v) for v in data.vertices.tolist()], [], [list(f) for f in data.faces])

@@ -126,3 +126,25 @@ def test_snap_to_photo_moves_the_clicks_onto_the_walls(panorama_room: np.ndarray
 
     assert error(after) < 0.5 * error(before)
     assert [tuple(c.point) for c in scene.dimred_room.corners] != [tuple(p) for p in panorama_room]
+
+
+def test_object_from_photo_boxes_the_clicked_object(panorama_room: np.ndarray, tmp_path: Path) -> None:
+    from addon.roommatch.projection import project
+    from tests.engine.roommatch.room_truth import with_box
+
+    chair = np.array([1.8, 0.6, np.log(0.8), np.log(0.7), np.log(0.9), np.radians(20.0)])
+    hdri = tmp_path / "chair.exr"
+    tiny_scene.write_exr(hdri, with_box(flat_panorama(BOX, CEILING, PROBE, 1024, 512), chair, 1.5, (0.7, 0.6, 0.1)))
+    from addon.blender import room_builder
+
+    room_builder.show_panorama(bpy.context.scene, str(hdri))
+    _click_all(clicks_of(floor_points(BOX), PROBE, 1024, 512))
+    bpy.context.scene.dimred_room.camera_height = 1.5
+    bpy.ops.dimred.match_room()
+    x, y = np.round(project(np.array([1.8, 0.6, 0.45 - 1.5]), 1024, 512))
+    assert bpy.ops.dimred.object_from_photo(x=float(x), y=float(y), name="Chair") == {'FINISHED'}
+    corners = _vertices("Chair")
+    assert corners[:, 2].min() == pytest.approx(0.0, abs=1e-6)
+    assert corners[:, 2].max() == pytest.approx(0.9, rel=0.08)
+    assert corners[:, :2].mean(axis=0) == pytest.approx(chair[:2], abs=0.05)
+    assert bpy.context.scene.dimred.target.name == "Chair"
