@@ -161,6 +161,36 @@ class DIMRED_OT_room_click(bpy.types.Operator):
         return {'PASS_THROUGH'}
 
 
+class DIMRED_OT_room_suggest(bpy.types.Operator):
+    bl_idname = "dimred.room_suggest"
+    bl_label = "Suggest Room"
+    bl_description = ("Propose the floor's corners from the photograph's lines (a room with right-angled walls): "
+                      "they replace the clicks, to accept with Match Room or correct first")
+    bl_options = {'REGISTER', 'UNDO'}
+
+    def execute(self, context: bpy.types.Context) -> set[str]:
+        from ..addon.blender import reader, room_builder
+        from ..addon.roommatch.suggest import suggest_room
+
+        scene = context.scene
+        try:
+            panorama = reader.panorama_pixels(scene)
+        except DimredError as error:
+            self.report({'ERROR'}, str(error))
+            return {'CANCELLED'}
+        height, width = panorama.shape[:2]
+        found = suggest_room(panorama, width=width, height=height, rotation=room_builder.panorama_rotation(scene))
+        if found.clicks is None:
+            self.report({'WARNING'}, found.message)
+            return {'CANCELLED'}
+        room = scene.dimred_room
+        camera = room.camera_height
+        room.load(found.clicks)
+        room.camera_height = camera  # the suggestion has no scale: the height set stays
+        self.report({'INFO'}, found.message + ": check them, then Match Room")
+        return {'FINISHED'}
+
+
 class DIMRED_OT_object_from_photo(bpy.types.Operator):
     bl_idname = "dimred.object_from_photo"
     bl_label = "Object from Photo"
@@ -333,8 +363,8 @@ def _world_size(scene: bpy.types.Scene) -> tuple[int, int] | None:
         return None
 
 
-classes = (DIMRED_OT_match_room, DIMRED_OT_room_click, DIMRED_OT_object_from_photo, DIMRED_OT_room_remove_corner,
-           DIMRED_OT_room_clear, DIMRED_OT_room_load_clicks, DIMRED_OT_room_save_clicks,
+classes = (DIMRED_OT_match_room, DIMRED_OT_room_click, DIMRED_OT_room_suggest, DIMRED_OT_object_from_photo,
+           DIMRED_OT_room_remove_corner, DIMRED_OT_room_clear, DIMRED_OT_room_load_clicks, DIMRED_OT_room_save_clicks,
            DIMRED_OT_show_room_diagnostics)
 
 register, unregister = bpy.utils.register_classes_factory(classes)

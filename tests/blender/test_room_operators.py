@@ -148,3 +148,29 @@ def test_object_from_photo_boxes_the_clicked_object(panorama_room: np.ndarray, t
     assert corners[:, 2].max() == pytest.approx(0.9, rel=0.08)
     assert corners[:, :2].mean(axis=0) == pytest.approx(chair[:2], abs=0.05)
     assert bpy.context.scene.dimred.target.name == "Chair"
+
+
+def test_suggest_room_proposes_the_corners(panorama_room: np.ndarray, tmp_path: Path) -> None:
+    from addon.blender import room_builder
+
+    hdri = tmp_path / "wide.exr"
+    tiny_scene.write_exr(hdri, flat_panorama(BOX, CEILING, PROBE, 1024, 512))
+    room_builder.show_panorama(bpy.context.scene, str(hdri))
+    scene = bpy.context.scene
+    scene.dimred_room.camera_height = 1.5
+    assert bpy.ops.dimred.room_suggest() == {'FINISHED'}
+    assert len(scene.dimred_room.corners) == 4 and scene.dimred_room.manhattan
+    assert scene.dimred_room.camera_height == 1.5
+    bpy.ops.dimred.match_room()
+    floor = _vertices("Floor")[:, :2]
+    assert max(np.min(np.linalg.norm(floor - c, axis=1)) for c in BOX) < 0.05
+
+
+def test_suggest_room_says_when_it_finds_nothing(registered, tmp_path: Path) -> None:
+    from addon.blender import room_builder
+
+    hdri = tmp_path / "noise.exr"
+    tiny_scene.write_exr(hdri, np.random.default_rng(3).random((128, 256, 3)).astype(np.float32) + 0.1)
+    room_builder.show_panorama(bpy.context.scene, str(hdri))
+    assert bpy.ops.dimred.room_suggest() == {'CANCELLED'}
+    assert len(bpy.context.scene.dimred_room.corners) == 0

@@ -7,6 +7,8 @@ a known length instead; the reprojected edges on the render's.
 """
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -15,6 +17,7 @@ from addon.roommatch.clicks import KnownLength, RoomClicks
 from addon.roommatch.fit import fit_room
 from addon.roommatch.photo_edges import edge_offsets
 from addon.roommatch.refine import refine_clicks
+from addon.roommatch.suggest import suggest_room
 from scenes.rooms import ROOMS, RoomScene, render_room
 from tests.engine.roommatch.room_truth import clicks_of, distance_errors, floor_points, rotation_z
 
@@ -83,3 +86,16 @@ def test_reprojected_edges_lie_on_the_render(rendered) -> None:
     floor_edges = found.offsets[: len(floor)]
     assert np.nanmax(floor_edges) < 1.0
     assert np.isfinite(floor_edges).sum() >= len(floor) - 1
+
+
+def test_suggestion_on_the_turned_room() -> None:
+    # The rectangle is suggested whole; the L-shaped room's short inner walls are not traced
+    # apart from their neighbours, so it is suggested as its bounding rectangle (docs/limits.md).
+    room = ROOMS["turned_room"]
+    corners, probe, rotation, _ = _setup(room)
+    found = suggest_room(read_exr(render_room(room)), width=room.width, height=room.height, rotation=rotation)
+    assert found.clicks is not None, found.message
+    fitted = fit_room(dataclasses.replace(found.clicks, camera_height=room.probe[2]), rotation=rotation,
+                      origin=room.probe[:2])
+    nearest = np.array([fitted.corners[np.argmin(np.linalg.norm(fitted.corners - c, axis=1))] for c in corners])
+    assert distance_errors(nearest, corners, probe).max() < 0.015
