@@ -71,11 +71,14 @@ def match(scene: bpy.types.Scene, *, snap: bool = False) -> str:
     room.matched, room.problem = True, ""
     room.summary = json.dumps(fitted.summary())
     if panorama is not None:
-        picture = pictures.Picture.of(room_picture(panorama, fitted, clicks, rotation=rotation))
-        pictures.show_diagnostics(picture, ROOM_DIAGNOSTICS_IMAGE)
+        show_room_picture(room_picture(panorama, fitted, clicks, rotation=rotation))
     return (f"Room matched: {len(clicks.floor)} corners, camera {fitted.camera_height:.2f} m "
             f"({fitted.scale_source}), ceiling {fitted.ceiling_height:.2f} m, "
             f"corners within {fitted.corner_errors.max():.2f} px of their clicks{snapped}")
+
+
+def show_room_picture(picture: np.ndarray) -> None:
+    pictures.show_diagnostics(pictures.Picture.of(picture), ROOM_DIAGNOSTICS_IMAGE)
 
 
 class DIMRED_OT_match_room(bpy.types.Operator):
@@ -214,14 +217,23 @@ class DIMRED_OT_object_from_photo(bpy.types.Operator):
             size = (self.width, self.height) if self.width and self.height else _world_size(scene)
             if size is None:
                 raise DimredError("the world shows no panorama: add an Environment Texture with the HDRI")
-            box = box_from_click(reader.panorama_pixels(scene), (self.x, self.y), click_size=size,
-                                 probe=reader.probe_center(scene), floor_z=room_builder.floor_height(scene),
-                                 rotation=room_builder.panorama_rotation(scene))
+            panorama, probe = reader.panorama_pixels(scene), reader.probe_center(scene)
+            rotation = room_builder.panorama_rotation(scene)
+            box = box_from_click(panorama, (self.x, self.y), click_size=size, probe=probe,
+                                 floor_z=room_builder.floor_height(scene), rotation=rotation)
         except DimredError as error:
             self.report({'ERROR'}, str(error))
             return {'CANCELLED'}
         obj = room_builder.box_object(scene, self.name, box.corners())
         scene.dimred.mark(obj)
+        room = scene.dimred_room
+        if room.matched and not room.problem:  # the room's picture shows the new box too
+            from ..addon.roommatch.diagnostics import room_picture
+            from ..addon.roommatch.fit import fit_room
+
+            clicks = room.clicks()
+            fitted = fit_room(clicks, rotation=rotation, origin=tuple(probe[:2]), ceiling_height=room.ceiling_height)
+            show_room_picture(room_picture(panorama, fitted, clicks, boxes=(box.corners(),), rotation=rotation))
         width, depth, tall = box.size
         self.report({'INFO'}, f"'{obj.name}': {width:.2f} × {depth:.2f} × {tall:.2f} m, turned "
                               f"{np.degrees(box.turn):.1f}°, {100 * box.agreement:.0f} % of the outline agrees")

@@ -24,6 +24,9 @@ it an empty scene, whose world shows --panorama). Writes into the output folder:
   room_diagnostics.png  the panorama with every edge of the room drawn over it (green floor,
                         magenta ceiling, cyan corners; the clicks in yellow)
 
+With --object-at X Y, also the box proxy of the object clicked there (Object from Photo): its
+width, depth, height and turn fitted to the object's outline, "object" in room.json.
+
 A click file: {"width": W, "height": H, "floor": [[x, y], ...], "ceiling": [x, y],
 "camera_height": 1.6 | "known_length": {"kind": "wall", "edge": 0, "metres": 3.2} or
 {"kind": "vertical" | "floor", "from": [x, y], "to": [x, y], "metres": 2.0}, "manhattan": true}.
@@ -49,6 +52,10 @@ def add_command(commands: argparse._SubParsersAction, *, formatter: type[argpars
     room.add_argument("--snap", action="store_true",
                       help="first move the floor corners onto the wall-floor edges the panorama shows near them "
                            "(walls it hides keep their clicks); room.json keeps the clicks as given")
+    room.add_argument("--object-at", nargs=2, type=float, metavar=("X", "Y"),
+                      help="Object from Photo: also fit a box proxy to the object clicked at pixel (X, Y) of the "
+                           "click file's panorama, standing on the floor, and mark it for removal")
+    room.add_argument("--object-name", default="Object", metavar="NAME", help="that proxy's name (default: Object)")
     room.set_defaults(run=_room, inside_blender=inside_blender)
 
 
@@ -61,6 +68,7 @@ def _room(args: argparse.Namespace) -> int:
     from ..roommatch import clicks as click_file
     from ..roommatch.diagnostics import room_picture
     from ..roommatch.fit import DEFAULT_CEILING_HEIGHT, fit_room
+    from ..roommatch.object_box import box_from_click
     from ..roommatch.photo_edges import edge_offsets
     from ..roommatch.refine import refine_clicks
     from . import reader, room_builder
@@ -102,12 +110,23 @@ def _room(args: argparse.Namespace) -> int:
         scene.dimred_room.load(clicks)
         scene.dimred_room.matched = True
     report.update(room=room.summary(), clicks=clicks.to_dict())
+    boxes: tuple[np.ndarray, ...] = ()
+    if args.object_at is not None:
+        if panorama is None:
+            raise DimredError(f"--object-at needs the panorama: {missing}")
+        box = box_from_click(panorama, tuple(args.object_at), click_size=(clicks.width, clicks.height),
+                             probe=room.probe, rotation=rotation)
+        obj = room_builder.box_object(scene, args.object_name, box.corners())
+        if hasattr(scene, "dimred"):
+            scene.dimred.mark(obj)
+        report["object"] = {"name": obj.name, **box.summary()}
+        boxes = (box.corners(),)
     writers = {}
     if panorama is None:
         report["diagnostics"] = f"no room_diagnostics.png: {missing}"
     else:
         report["photo_edges"] = edge_offsets(panorama, room, rotation=rotation).summary()
-        picture = room_picture(panorama, room, clicks, rotation=rotation)
+        picture = room_picture(panorama, room, clicks, boxes=boxes, rotation=rotation)
         writers["room_diagnostics.png"] = lambda path: exr.write_png(path, picture)
     writers["room.json"] = outputs.json_writer(report)
     outputs.write_files(args.out, writers, stale=("room_diagnostics.png",))
@@ -116,6 +135,7 @@ def _room(args: argparse.Namespace) -> int:
     except RuntimeError as error:
         raise DimredError(f"cannot save {save}: {str(error).strip()}") from None
     worst = float(np.max(room.corner_errors))
-    print(f"dimred: matched the room: {len(clicks.floor)} corners, camera {room.camera_height:.3f} m, ceiling {room.ceiling_height:.3f} m, "
-          f"corners within {worst:.2f} px; saved {save}, wrote {args.out}", flush=True)
+    print(f"dimred: matched the room: {len(clicks.floor)} corners, camera {room.camera_height:.3f} m, "
+          f"ceiling {room.ceiling_height:.3f} m, corners within {worst:.2f} px; saved {save}, wrote {args.out}",
+          flush=True)
     return 0

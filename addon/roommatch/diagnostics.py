@@ -1,7 +1,7 @@
 """room_diagnostics.png: the whole panorama with every edge of the matched room drawn over it.
 
-Floor edges green, ceiling edges magenta, the walls' vertical corners cyan, each curve where it
-reprojects in lat-long; the clicks as yellow crosses. A wall in the wrong place shows as a line
+Floor edges green, ceiling edges magenta, the walls' vertical corners cyan, object boxes orange,
+each curve where it reprojects in lat-long; the clicks as yellow crosses. A wall in the wrong place shows as a line
 beside the photograph's.
 """
 from __future__ import annotations
@@ -15,26 +15,33 @@ from .fit import RoomFit
 from .meshes import room_edges
 from .projection import project
 
-_COLOURS = np.array([[0.1, 1.0, 0.2], [1.0, 0.2, 1.0], [0.0, 1.0, 1.0]], dtype=np.float32)  # floor, ceiling, corner
+# Floor, ceiling, wall corner, object box.
+_COLOURS = np.array([[0.1, 1.0, 0.2], [1.0, 0.2, 1.0], [0.0, 1.0, 1.0], [1.0, 0.55, 0.0]], dtype=np.float32)
+# A box's 12 edges between its corners (the bottom four, then the top four).
+_BOX_EDGES = np.array([(0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (5, 6), (6, 7), (7, 4), (0, 4), (1, 5), (2, 6), (3, 7)])
 _CLICK = np.array([1.0, 0.9, 0.0], dtype=np.float32)
 _SAMPLES = 4000  # along one edge: under half a pixel apart at 2048 wide
 
 
 def room_picture(panorama: np.ndarray, room: RoomFit, clicks: RoomClicks | None = None, *,
-                 rotation: np.ndarray | None = None, max_width: int = 2048) -> np.ndarray:
+                 boxes: tuple[np.ndarray, ...] = (), rotation: np.ndarray | None = None,
+                 max_width: int = 2048) -> np.ndarray:
     """(h, w, 3) uint8 sRGB picture of `panorama` (H, W, 3) linear RGB, top row first, reduced
-    to at most `max_width` wide, with `room`'s edges and the `clicks` drawn."""
+    to at most `max_width` wide, with `room`'s edges, the `boxes` ((8, 3) world corners each)
+    and the `clicks` drawn."""
     image = np.asarray(panorama, dtype=np.float32)
     height, width = image.shape[:2]
     if width > max_width:
         height, width = max(1, round(height * max_width / width)), max_width
         image = resample_axis(resample_axis(image, height, axis=0), width, axis=1)
     picture = _tone_map(image)
-    edges = room_edges(room) - room.probe
+    walls = room_edges(room)
+    box_edges = [np.asarray(corners, dtype=np.float64)[_BOX_EDGES] for corners in boxes]
+    edges = np.concatenate([walls, *box_edges]) - room.probe
     t = np.linspace(0.0, 1.0, _SAMPLES)[None, :, None]
     points = edges[:, :1] + t * (edges[:, 1:] - edges[:, :1])
     xy = project(points, width, height, rotation)
-    kind = np.repeat(np.arange(3), len(edges) // 3)
+    kind = np.concatenate([np.repeat(np.arange(3), len(walls) // 3), np.full(12 * len(boxes), 3)])
     colour = np.broadcast_to(_COLOURS[kind][:, None, :], (*xy.shape[:2], 3))
     _stamp(picture, xy.reshape(-1, 2), colour.reshape(-1, 3), radius=1)
     if clicks is not None:
