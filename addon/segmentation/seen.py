@@ -30,6 +30,8 @@ _PAD = 2  # pixels the window reaches past the band
 _MIN_BAND = 3
 _SHADOW = 0.9  # an added pixel this much darker than the brightest background around it, ...
 _SHADOW_CHROMA = 0.08  # ... its log chromaticity this close to the background's, is its shadow
+_DARKEST = 0.3  # below the object, below this share of the background's median, ...
+_LEG_CHROMA = 0.15  # ... its log chromaticity this far from the background's: the object's own
 # A proxy whose silhouette and the segmented object share less than this is not over the object.
 _MIN_OVERLAP = 0.25
 _MIN_SEPARATION = 0.8  # below this the two sides' colours cannot be told apart ...
@@ -146,6 +148,8 @@ def seen_object(hdri: np.ndarray, geo: Geometry, index: int, *, segment: bool = 
                     rep.warn(f"the photograph does not set '{name}' apart from its surroundings: its proxy's "
                              "silhouette and the mask are filled")
     shown = proxy | _added(image, proxy, seg, band_px) if seg is not None else proxy.copy()
+    if seg is not None:
+        shown |= _attached_dark(image, shown, band_px)
     if mask is not None:
         add, take = mask.in_frame(frame, shape)
         shown = (shown | add) & ~take
@@ -234,6 +238,40 @@ def _added(image: np.ndarray, proxy: np.ndarray, seg: ObjectSegmentation, band: 
     darker = log_y < local[..., 0] + np.log(_SHADOW)
     alike = np.abs(chroma - local_chroma).max(axis=2) < _SHADOW_CHROMA
     return added & ~(darker & alike & (weight > 0))
+
+
+def _attached_dark(image: np.ndarray, shown: np.ndarray, band: int) -> np.ndarray:
+    """The pixels within `band` below the middle of the `shown` object, joined to it through such
+    pixels, that are darker than `_DARKEST` of the background around them there (its median
+    luminance within two bands) and clearly not in its colour: a leg of dark wood, the dark
+    pixels where it touches the floor. A colour model of the object's body leaves them to the
+    background; left, a box proxy's fill keeps a chair's legs standing in the room. A shadow
+    keeps the floor's colour and is relit instead (its texture is the photograph's), and what
+    is beside the object's upper half (a dark curtain, a desk's side) is not its legs."""
+    rows = np.nonzero(shown)[0]
+    if not len(rows):
+        return np.zeros_like(shown)
+    lower = (np.arange(shown.shape[0]) > np.median(rows))[:, None]
+    # Smoothed once: a leg may be a few pixels wide.
+    rgb = blur(np.maximum(image, 0.0)).astype(np.float64) + 1e-6 * max(float(image.mean()), 1e-30)
+    y = rgb @ LUMA
+    chroma = np.log(rgb[..., [0, 2]] / rgb[..., 1:2])
+    around = ~shown & dilate(shown, 2 * band) & lower
+    if not around.any():
+        return np.zeros_like(shown)
+    background = np.median(chroma[around], axis=0)
+    dark = (around & (y < _DARKEST * float(np.median(y[around])))
+            & (np.abs(chroma - background).max(axis=2) >= _LEG_CHROMA))
+    reach = dark & dilate(shown, band)
+    grown = np.zeros_like(shown)
+    for _ in range(band):
+        # two pixels at a time: smoothing brightens the pixels where a leg meets a bright body
+        step = reach & dilate(shown | grown, 2) & ~grown
+        if not step.any():
+            break
+        grown |= step
+    # with the pixels its edge shares with the floor
+    return dilate(grown, 1) & around
 
 
 def _check_overlap(seg: ObjectSegmentation, proxy: np.ndarray, name: str) -> None:
