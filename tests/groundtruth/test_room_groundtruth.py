@@ -98,4 +98,4 @@ def test_suggestion_on_the_turned_room() -> None:
     fitted = fit_room(dataclasses.replace(found.clicks, camera_height=room.probe[2]), rotation=rotation,
                       origin=room.probe[:2])
     nearest = np.array([fitted.corners[np.argmin(np.linalg.norm(fitted.corners - c, axis=1))] for c in corners])
-    assert distance_errors(nearest, corners, probe).max() < 0.015
+    assert distance_errors(nearest, corners, probe).max() < 0.01
