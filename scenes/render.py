@@ -61,7 +61,9 @@ def _render_into_cache(spec: SceneSpec, paths: dict[str, Path], cache_root: Path
         truth = _cached_truth(spec, cache_root)
         if truth is not None:
             shutil.copyfile(truth, work / FILES["truth"])
-        _job(["pair", str(work)], f"render of {spec.name!r}", timeout)
+        # Scenes with a photographed floor, windows or chairs build with scenes.build_extended.
+        module = "scenes.build_extended" if spec.extended() else "scenes.render_job"
+        _job(["pair", str(work)], f"render of {spec.name!r}", timeout, module)
         folder = paths["input"].parent
         try:
             work.rename(folder)
@@ -101,10 +103,10 @@ def render_world(blend: str | Path, out_exr: str | Path,
     return read_exr(out_exr)
 
 
-def _job(args: list[str], what: str, timeout: float | None) -> None:
+def _job(args: list[str], what: str, timeout: float | None, module: str = "scenes.render_job") -> None:
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(
         [str(REPO), *filter(None, [os.environ.get("PYTHONPATH")])]))
-    proc = subprocess.run([sys.executable, "-m", "scenes.render_job", *args], cwd=REPO, env=env,
+    proc = subprocess.run([sys.executable, "-m", module, *args], cwd=REPO, env=env,
                           capture_output=True, text=True, timeout=timeout)
     if proc.returncode != 0:
         tail = (proc.stdout + proc.stderr)[-3000:]

@@ -24,24 +24,53 @@ from typing import Any
 Vec2 = tuple[float, float]
 Vec3 = tuple[float, float, float]
 
-FLOOR_PATTERNS = ("checker", "planks", "noise", "plain")
-OBJECT_KINDS = ("box", "stool", "cylinder", "sphere")
+FLOOR_PATTERNS = ("checker", "planks", "noise", "plain", "photo")
+OBJECT_KINDS = ("box", "stool", "cylinder", "sphere", "chair")
+WALLS = ("west", "east", "south", "north")
 # Names `build` gives the room, lamps, probe and camera; objects must not take them.
 RESERVED_NAMES = ("Floor", "Ceiling", "ProbeCenter", "ProbeCamera")
-RESERVED_PREFIXES = ("Wall.", "Lamp.", "LampHousing.")
+RESERVED_PREFIXES = ("Wall.", "Lamp.", "LampHousing.", "Window.", "WindowHousing.", "Sun.")
 
 # Sources whose changes alter the pixels; hashed into every key so a stale cache cannot be hit.
 _RENDER_SOURCES = ("build.py", "render_job.py")
+# What only the photo-textured rooms use (a floor from a photograph, windows, chairs) is built by
+# these, hashed into those scenes' keys alone: build.py and render_job.py stay as they were, so
+# the other scenes keep their keys and their cached renders.
+_EXTENDED_SOURCES = ("build_extended.py", "photo_texture.py")
+# Fields added after renders were cached: left out of the JSON at their default, so that a spec
+# which does not use them hashes as before.
+_ADDED = {"added": True}
+
+
+@dataclass(frozen=True)
+class Photo:
+    """A real panorama projected onto the floor plane as albedo (`scenes.photo_texture`).
+
+    `source` is a file of the shared real photographs (`apartment.exr`, ...) or Blender's bundled
+    `interior.exr`. The photograph's camera stood `height` metres above the floor at `origin`
+    (x, y), turned by `yaw` degrees about the vertical: the room's direction at azimuth a shows
+    the photograph's at a - yaw. Its radiance is scaled so that the floor's median luminance is
+    `median` and clipped at `ceiling`; `texel` metres per texel."""
+
+    source: str
+    origin: Vec2 = (0.0, 0.0)
+    height: float = 1.6
+    yaw: float = 0.0
+    median: float = 0.35
+    ceiling: float = 0.9
+    texel: float = 0.01
 
 
 @dataclass(frozen=True)
 class Floor:
-    """Floor albedo: `pattern` of `color1`/`color2`, `scale` metres per tile, plank or feature."""
+    """Floor albedo: `pattern` of `color1`/`color2`, `scale` metres per tile, plank or feature;
+    pattern 'photo' takes it from `photo` instead."""
 
     pattern: str = "plain"
     color1: Vec3 = (0.6, 0.6, 0.6)
     color2: Vec3 = (0.3, 0.3, 0.3)
     scale: float = 0.5
+    photo: Photo | None = field(default=None, metadata=_ADDED)
 
 
 @dataclass(frozen=True)
@@ -66,12 +95,33 @@ class Lamp:
 
 
 @dataclass(frozen=True)
+class Window:
+    """An emitting quad in a hole of a wall, closed behind by a black housing (as the lamps are
+    in the ceiling): the daylight of a window. `wall` is one of `WALLS` (west: x = lo[0], east:
+    x = hi[0], south: y = lo[1], north: y = hi[1]); `center` is (position along the wall in
+    world x or y, height above the floor) and `size` (width, height), in metres. `sun_strength`,
+    when positive, adds a `sun_size` metres square of that radiance at the window's centre, just
+    inside the room: a small, very bright source whose hard shadows are the sun's."""
+
+    wall: str
+    center: Vec2
+    size: Vec2
+    strength: float
+    color: Vec3 = (1.0, 1.0, 1.0)
+    sun_strength: float = 0.0
+    sun_size: float = 0.15
+    sun_color: Vec3 = (1.0, 0.95, 0.85)
+
+
+@dataclass(frozen=True)
 class SceneObject:
     """A mesh object. `size` is its bounding box (x, y, z) before the rotation about Z.
 
     `location` is the bottom centre; its z defaults to the floor. A cylinder or sphere with
     unequal x and y is elliptic. Stools use `seat` ('round' or 'square'), `legs` (3 or 4),
-    `leg_width` and `seat_thickness`; other kinds ignore them.
+    `leg_width` and `seat_thickness`; other kinds ignore them. A chair has a square seat of
+    that thickness whose top is `seat_height` above the floor, four legs in its corners and a
+    back on its -y side rising to the full height.
     """
 
     name: str
@@ -84,6 +134,7 @@ class SceneObject:
     legs: int = 4
     leg_width: float = 0.03
     seat_thickness: float = 0.04
+    seat_height: float | None = field(default=None, metadata=_ADDED)
 
 
 @dataclass(frozen=True)
@@ -109,6 +160,7 @@ class SceneSpec:
     remove: str
     world_rotation_z: float = 0.0
     render: Render = field(default_factory=Render)
+    windows: tuple[Window, ...] = field(default=(), metadata=_ADDED)
 
     def __post_init__(self) -> None:
         _validate(self)
@@ -120,12 +172,21 @@ class SceneSpec:
         """The same scene with some `Render` fields changed (width, height, samples, ...)."""
         return dataclasses.replace(self, render=dataclasses.replace(self.render, **changes))
 
+    def extended(self) -> bool:
+        """Whether the scene uses what `scenes.build_extended` builds: a floor from a
+        photograph, windows or chairs."""
+        return (self.room.floor.photo is not None or bool(self.windows)
+                or any(o.kind == "chair" for o in self.objects))
+
     def to_dict(self) -> dict[str, Any]:
-        return dataclasses.asdict(self)
+        return _as_dict(self)
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> SceneSpec:
-        room = dict(d["room"], floor=Floor(**_tuples(d["room"]["floor"])))
+        floor = dict(d["room"]["floor"])
+        if floor.get("photo") is not None:
+            floor["photo"] = Photo(**_tuples(floor["photo"]))
+        room = dict(d["room"], floor=Floor(**_tuples(floor)))
         return cls(
             name=d["name"],
             room=Room(**_tuples(room)),
@@ -135,6 +196,7 @@ class SceneSpec:
             remove=d["remove"],
             world_rotation_z=d["world_rotation_z"],
             render=Render(**d["render"]),
+            windows=tuple(Window(**_tuples(x)) for x in d.get("windows", ())),
         )
 
     def to_json(self) -> str:
@@ -146,7 +208,7 @@ class SceneSpec:
 
     def key(self) -> str:
         """Stable hash of every field, the render code and the bpy version (cache folder name)."""
-        return _hashed(self.to_json())
+        return _hashed(self.to_json(), extended=self.extended())
 
     def truth_key(self) -> str:
         """`key` of what the render without the removed object shows: the scene less that
@@ -156,13 +218,25 @@ class SceneSpec:
         d = self.to_dict()
         d["objects"] = [o for o in d["objects"] if o["name"] != self.remove]
         del d["name"], d["remove"]
-        return _hashed(json.dumps(d, sort_keys=True))
+        return _hashed(json.dumps(d, sort_keys=True), extended=self.extended())
 
 
-def _hashed(text: str) -> str:
+def _hashed(text: str, *, extended: bool) -> str:
     h = hashlib.sha256(text.encode())
     h.update(_render_fingerprint().encode())
+    if extended:
+        h.update(_extended_fingerprint().encode())
     return h.hexdigest()[:20]
+
+
+def _as_dict(value: Any) -> Any:
+    """`dataclasses.asdict`, less the `_ADDED` fields at their default."""
+    if dataclasses.is_dataclass(value):
+        return {f.name: _as_dict(getattr(value, f.name)) for f in dataclasses.fields(value)
+                if not (f.metadata.get("added") and getattr(value, f.name) == f.default)}
+    if isinstance(value, (tuple, list)):
+        return type(value)(_as_dict(v) for v in value)
+    return value
 
 
 def _tuples(d: dict[str, Any]) -> dict[str, Any]:
@@ -176,6 +250,21 @@ def _render_fingerprint() -> str:
     h = hashlib.sha256(importlib.metadata.version("bpy").encode())
     for name in _RENDER_SOURCES:
         h.update(_code_only((here / name).read_text()).encode())
+    return h.hexdigest()
+
+
+@cache
+def _extended_fingerprint() -> str:
+    # The photographs are part of the pixels too; interior.exr comes with bpy, whose version
+    # is in every key already.
+    from .photo_texture import PHOTOS
+
+    here = Path(__file__).resolve().parent
+    h = hashlib.sha256()
+    for name in _EXTENDED_SOURCES:
+        h.update(_code_only((here / name).read_text()).encode())
+    for path in sorted(PHOTOS.glob("*.exr")):
+        h.update(path.name.encode() + hashlib.sha256(path.read_bytes()).digest())
     return h.hexdigest()
 
 
@@ -206,6 +295,17 @@ def _validate(spec: SceneSpec) -> None:
         raise ValueError(f"{spec.name}: probe {spec.probe} outside the room")
     if spec.room.floor.pattern not in FLOOR_PATTERNS:
         raise ValueError(f"{spec.name}: floor pattern {spec.room.floor.pattern!r}")
+    if (spec.room.floor.pattern == "photo") != (spec.room.floor.photo is not None):
+        raise ValueError(f"{spec.name}: a floor has a photo exactly when its pattern is 'photo'")
+    for w in spec.windows:
+        if w.wall not in WALLS:
+            raise ValueError(f"{spec.name}: window wall {w.wall!r}, not one of {WALLS}")
+        axis = 1 if w.wall in ("west", "east") else 0
+        (a, z), (sa, sz) = w.center, w.size
+        if not (lo[axis] < a - sa / 2 and a + sa / 2 < hi[axis] and lo[2] < z - sz / 2 and z + sz / 2 < hi[2]):
+            raise ValueError(f"{spec.name}: window {w} not inside its wall")
+        if w.sun_strength > 0 and not (w.sun_size < min(sa, sz)):
+            raise ValueError(f"{spec.name}: the sun of window {w} is larger than the window")
     for lamp in spec.lamps:
         for c, s, low, high in zip(lamp.center, lamp.size, lo[:2], hi[:2], strict=True):
             if not (low < c - s / 2 and c + s / 2 < high):
@@ -215,8 +315,15 @@ def _validate(spec: SceneSpec) -> None:
             raise ValueError(f"{spec.name}: object kind {o.kind!r}")
         if o.kind == "stool" and (o.seat not in ("round", "square") or o.legs not in (3, 4)):
             raise ValueError(f"{spec.name}: stool {o.name} needs a round/square seat, 3-4 legs")
+        if (o.kind == "chair") != (o.seat_height is not None):
+            raise ValueError(f"{spec.name}: {o.name}: a seat height is for chairs, and chairs need one")
+        if o.kind == "chair" and not (o.seat_thickness < o.seat_height < o.size[2]):
+            raise ValueError(f"{spec.name}: chair {o.name}'s seat must lie between the floor and its top")
     albedos = [spec.room.wall_albedo, spec.room.ceiling_albedo, spec.room.floor.color1,
                spec.room.floor.color2] + [o.albedo for o in spec.objects]
+    photo = spec.room.floor.photo
+    if photo is not None and not (0.0 < photo.median < photo.ceiling < 1.0):
+        raise ValueError(f"{spec.name}: a photo floor's median and ceiling must rise in (0, 1)")
     if not all(0.0 <= c < 1.0 for a in albedos for c in a):
         raise ValueError(f"{spec.name}: albedos must lie in [0, 1)")
 
@@ -600,6 +707,134 @@ SPECS: dict[str, SceneSpec] = {s.name: s for s in (
 )}
 
 
+# ---------------------------------------------------------------------------------------------
+# Photo-textured rooms: floors projected from real photographs (their grain, rugs, furniture feet
+# and contact shadows printed on them), lit by a window and ceiling lamps, a box, a stool or a
+# chair to remove. Where the clean floor is measured (issue: clutter never copied into the hole).
+# 512x256 at 32 samples: the objects cover a few hundred pixels.
+
+_PHOTO_RENDER = Render(512, 256, 32)
+
+
+def _photo_floor(source: str, **projection: Any) -> Floor:
+    return Floor("photo", photo=Photo(source, **projection))
+
+
+def _hotel_box() -> SceneSpec:
+    # Blender's hotel room: the curtained window is at +x in the photograph, and so here; a
+    # 0.5 m box on the wood between the striped rug and the desk chair's foot.
+    room = Room(lo=(-1.4, -1.2, 0.0), hi=(1.8, 2.4, 2.6), wall_albedo=(0.78, 0.75, 0.7),
+                floor=_photo_floor("interior.exr", height=1.5))
+    return SceneSpec(
+        name="hotel_box",
+        room=room,
+        lamps=(Lamp((-0.5, 1.5), (0.3, 0.3), 30.0, (1.0, 0.9, 0.75)),),
+        objects=(SceneObject("Box", "box", (0.5, 0.5, 0.5), _on_floor(room, 0.65, 0.7), (0.5, 0.48, 0.45),
+                             rotation_z=10.0),),
+        probe=(0.0, -0.4, 1.5),
+        remove="Box",
+        render=_PHOTO_RENDER,
+        windows=(Window("east", (0.5, 1.4), (1.6, 1.7), 5.0, (1.0, 0.97, 0.92)),),
+    )
+
+
+def _hotel_chair() -> SceneSpec:
+    room = Room(lo=(-1.4, -1.2, 0.0), hi=(1.8, 2.4, 2.6), wall_albedo=(0.78, 0.75, 0.7),
+                floor=_photo_floor("interior.exr", height=1.5))
+    # The same floor seen from elsewhere, a dark chair with its back to the window, a sun patch.
+    return SceneSpec(
+        name="hotel_chair",
+        room=room,
+        lamps=(Lamp((-0.5, 1.5), (0.3, 0.3), 30.0, (1.0, 0.9, 0.75)), Lamp((0.2, -0.6), (0.3, 0.3), 20.0)),
+        objects=(SceneObject("Chair", "chair", (0.46, 0.44, 0.85), _on_floor(room, 1.0, 0.2), (0.18, 0.12, 0.08),
+                             rotation_z=-90.0, leg_width=0.035, seat_thickness=0.05, seat_height=0.45),),
+        probe=(-0.5, 0.6, 1.45),
+        remove="Chair",
+        render=_PHOTO_RENDER,
+        windows=(Window("east", (0.5, 1.4), (1.6, 1.7), 4.0, (1.0, 0.97, 0.92), sun_strength=1500.0),),
+    )
+
+
+def _apartment_chair() -> SceneSpec:
+    # The empty apartment's wood floor with its sunlit patch, the window in the south wall where
+    # the photograph's is; a light chair turned towards the room.
+    room = Room(lo=(-2.2, -2.0, 0.0), hi=(2.4, 2.4, 2.7), wall_albedo=(0.82, 0.8, 0.76),
+                floor=_photo_floor("apartment.exr"))
+    return SceneSpec(
+        name="apartment_chair",
+        room=room,
+        lamps=(Lamp((0.6, 1.2), (0.5, 0.5), 25.0),),
+        objects=(SceneObject("Chair", "chair", (0.45, 0.45, 0.9), _on_floor(room, 1.1, 1.0), (0.6, 0.45, 0.3),
+                             rotation_z=30.0, seat_height=0.46),),
+        probe=(0.0, 0.0, 1.6),
+        remove="Chair",
+        render=_PHOTO_RENDER,
+        windows=(Window("south", (0.4, 1.35), (1.4, 1.7), 5.0, sun_strength=1200.0),),
+    )
+
+
+def _lobby_stool() -> SceneSpec:
+    # The lobby's wood floor with its red benches and a backpack printed on it; spots in a row.
+    room = Room(lo=(-3.0, -2.5, 0.0), hi=(3.0, 2.5, 2.8), wall_albedo=(0.75, 0.75, 0.72),
+                floor=_photo_floor("lobby.exr"))
+    return SceneSpec(
+        name="lobby_stool",
+        room=room,
+        lamps=(Lamp((-1.5, 0.0), (0.2, 0.2), 120.0), Lamp((0.0, 0.0), (0.2, 0.2), 120.0),
+               Lamp((1.5, 0.0), (0.2, 0.2), 120.0)),
+        objects=(SceneObject("Stool", "stool", (0.38, 0.38, 0.6), _on_floor(room, -0.6, -1.3), (0.25, 0.25, 0.28),
+                             rotation_z=15.0, seat="round", legs=4),),
+        probe=(0.2, 0.3, 1.6),
+        remove="Stool",
+        render=_PHOTO_RENDER,
+        windows=(Window("west", (0.0, 1.4), (2.0, 1.6), 4.0, (0.92, 0.96, 1.0)),),
+    )
+
+
+def _warehouse_box() -> SceneSpec:
+    # Plain concrete under strip lights, a crate, daylight from the north.
+    room = Room(lo=(-2.5, -2.5, 0.0), hi=(2.5, 2.5, 3.0), wall_albedo=(0.7, 0.7, 0.7),
+                floor=_photo_floor("warehouse.exr"))
+    return SceneSpec(
+        name="warehouse_box",
+        room=room,
+        lamps=(Lamp((-1.0, 0.0), (1.4, 0.15), 40.0), Lamp((1.2, 0.0), (1.4, 0.15), 40.0)),
+        objects=(SceneObject("Crate", "box", (0.6, 0.45, 0.5), _on_floor(room, 1.3, -1.1), (0.55, 0.45, 0.32),
+                             rotation_z=25.0),),
+        probe=(0.0, 0.2, 1.6),
+        remove="Crate",
+        render=_PHOTO_RENDER,
+        windows=(Window("north", (0.0, 1.6), (2.4, 1.4), 4.0),),
+    )
+
+
+def _workshop_box() -> SceneSpec:
+    # Green epoxy with yellow lines: a box beside a line, whose edge must run on through the hole.
+    room = Room(lo=(-2.5, -2.5, 0.0), hi=(2.5, 2.5, 3.0), wall_albedo=(0.74, 0.74, 0.72),
+                floor=_photo_floor("workshop.exr", yaw=20.0))
+    return SceneSpec(
+        name="workshop_box",
+        room=room,
+        lamps=(Lamp((0.5, 1.0), (0.6, 0.6), 25.0), Lamp((-1.2, -1.0), (0.6, 0.6), 20.0)),
+        objects=(SceneObject("Box", "box", (0.45, 0.45, 0.45), _on_floor(room, -1.2, 1.1), (0.3, 0.35, 0.5),
+                             rotation_z=-20.0),),
+        probe=(0.0, 0.0, 1.6),
+        remove="Box",
+        render=_PHOTO_RENDER,
+        windows=(Window("east", (0.0, 1.7), (2.0, 1.2), 4.0, sun_strength=1000.0),),
+    )
+
+
+PHOTO_SPECS: dict[str, SceneSpec] = {s.name: s for s in (
+    _hotel_box(),
+    _hotel_chair(),
+    _apartment_chair(),
+    _lobby_stool(),
+    _warehouse_box(),
+    _workshop_box(),
+)}
+
+
 def relocated(spec: SceneSpec, yaw: float, distance_scale: float) -> SceneSpec:
     """`spec` with its removed object moved under the fixed-view constraint: turned by `yaw`
     degrees about the vertical axis through the probe and its horizontal distance from that axis
@@ -616,8 +851,8 @@ def relocated(spec: SceneSpec, yaw: float, distance_scale: float) -> SceneSpec:
 
 
 def get(name: str) -> SceneSpec:
-    """The named spec; `KeyError` lists the known names."""
+    """The named spec (of `SPECS` or `PHOTO_SPECS`); `KeyError` lists the known names."""
     try:
-        return SPECS[name]
+        return SPECS[name] if name in SPECS else PHOTO_SPECS[name]
     except KeyError:
-        raise KeyError(f"unknown scene {name!r}; known: {', '.join(SPECS)}") from None
+        raise KeyError(f"unknown scene {name!r}; known: {', '.join([*SPECS, *PHOTO_SPECS])}") from None

@@ -2,6 +2,7 @@
 panorama convention (camera, formula and the world's Environment Texture agree)."""
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import subprocess
@@ -43,14 +44,32 @@ def rotated() -> S.SceneSpec:
 
 # --- specs (no rendering) -------------------------------------------------------------------
 
+ALL_SPECS = {**S.SPECS, **S.PHOTO_SPECS}
+
+
 def test_spec_json_round_trip_and_key() -> None:
-    for spec in S.SPECS.values():
+    for spec in ALL_SPECS.values():
         again = S.SceneSpec.from_json(spec.to_json())
         assert again == spec and again.key() == spec.key()
     base = S.get("basic_box")
     assert base.with_render(samples=5).key() != base.key()
     assert S.get("rotated_world").key() != base.key()
-    assert len({s.key() for s in S.SPECS.values()}) == len(S.SPECS)
+    assert len({s.key() for s in ALL_SPECS.values()}) == len(ALL_SPECS)
+
+
+def test_fields_added_for_photo_rooms_leave_the_other_keys_alone() -> None:
+    # Left out of the JSON at their default, and their build code hashed only into the keys of
+    # the scenes that use them: the older scenes' cached renders stay valid.
+    for spec in S.SPECS.values():
+        text = spec.to_json()
+        assert not spec.extended()
+        assert '"windows"' not in text and '"photo"' not in text and '"seat_height"' not in text
+    for spec in S.PHOTO_SPECS.values():
+        assert spec.extended() and spec.room.floor.photo is not None
+        plain = dataclasses.replace(spec, windows=(), room=dataclasses.replace(
+            spec.room, floor=S.Floor()), objects=tuple(
+            dataclasses.replace(o, kind="box", seat_height=None) for o in spec.objects))
+        assert not plain.extended()
 
 
 def test_spec_validation() -> None:
@@ -64,13 +83,27 @@ def test_spec_validation() -> None:
         S.SceneSpec(**{**base.__dict__, "objects": (floor,), "remove": "Floor"})
     with pytest.raises(KeyError, match="known"):
         S.get("no_such_scene")
+    photo = S.get("hotel_chair")
+    with pytest.raises(ValueError, match="photo"):
+        S.SceneSpec(**{**photo.__dict__, "room": dataclasses.replace(photo.room, floor=S.Floor("photo"))})
+    with pytest.raises(ValueError, match="window"):
+        w = dataclasses.replace(photo.windows[0], center=(2.3, 1.4))
+        S.SceneSpec(**{**photo.__dict__, "windows": (w,)})
+    with pytest.raises(ValueError, match="seat height"):
+        chair = dataclasses.replace(photo.objects[0], seat_height=None)
+        S.SceneSpec(**{**photo.__dict__, "objects": (chair,)})
 
 
 def test_named_specs_are_varied() -> None:
     assert {"basic_box", "red_box", "stool", "wall_contact", "bright_lamp", "seam", "nadir",
             "rotated_world", "second_object", "demo"} <= set(S.SPECS)
-    assert {s.room.floor.pattern for s in S.SPECS.values()} == set(S.FLOOR_PATTERNS)
-    assert {o.kind for s in S.SPECS.values() for o in s.objects} == set(S.OBJECT_KINDS)
+    assert {s.room.floor.pattern for s in ALL_SPECS.values()} == set(S.FLOOR_PATTERNS)
+    assert {o.kind for s in ALL_SPECS.values() for o in s.objects} == set(S.OBJECT_KINDS)
+    photo = S.PHOTO_SPECS.values()
+    assert len({s.room.floor.photo.source for s in photo}) >= 5
+    assert {w.wall for s in photo for w in s.windows} == set(S.WALLS)
+    assert any(w.sun_strength > 0 for s in photo for w in s.windows)
+    assert {s.removed_object().kind for s in photo} == {"box", "stool", "chair"}
     strengths = [lamp.strength for lamp in S.get("bright_lamp").lamps]
     assert max(strengths) >= 1000 * min(strengths)
 
@@ -95,6 +128,39 @@ def test_every_named_spec_builds() -> None:
         n = len(spec.lamps)
         assert {f"Lamp.{i:03d}" for i in range(1, n + 1)} <= names
         assert {f"LampHousing.{i:03d}" for i in range(1, n + 1)} <= names
+
+
+@pytest.mark.slow
+def test_every_photo_room_builds() -> None:
+    out = _py(
+        "import json, bpy\n"
+        "from scenes import spec, build_extended\n"
+        "res = {}\n"
+        "for name, s in spec.PHOTO_SPECS.items():\n"
+        "    bpy.ops.wm.read_factory_settings(use_empty=True)\n"
+        "    build_extended.build(s)\n"
+        "    objects = bpy.context.scene.objects\n"
+        "    floor = objects['Floor'].active_material.node_tree.nodes\n"
+        "    images = [n.image for n in floor if n.bl_idname == 'ShaderNodeTexImage']\n"
+        "    res[name] = {'names': sorted(o.name for o in objects),\n"
+        "                 'faces': {o.name: len(o.data.polygons) for o in objects if o.type == 'MESH'},\n"
+        "                 'floor_image': [(i.size[0], i.size[1], i.packed_file is not None) for i in images]}\n"
+        "print(json.dumps(res))\n")
+    built = json.loads(out.strip().splitlines()[-1])
+    for name, spec in S.PHOTO_SPECS.items():
+        names, faces = set(built[name]["names"]), built[name]["faces"]
+        assert {o.name for o in spec.objects} | {"Floor", "Ceiling", "Wall.North", "Wall.South"} <= names
+        # The photograph's texture, packed, one texel per `texel` metres of floor.
+        photo, (x0, y0, _), (x1, y1, _) = spec.room.floor.photo, spec.room.lo, spec.room.hi
+        assert built[name]["floor_image"] == [[round((x1 - x0) / photo.texel), round((y1 - y0) / photo.texel), True]]
+        for k, window in enumerate(spec.windows, start=1):
+            assert {f"Window.{k:03d}", f"WindowHousing.{k:03d}"} <= names
+            assert (f"Sun.{k:03d}" in names) == (window.sun_strength > 0)
+            # The wall around the hole: 3 x 3 cells less the window's.
+            assert faces[f"Wall.{window.wall.capitalize()}"] == 8
+        for o in spec.objects:
+            # A chair: seat, four legs (the rear two rising to the top) and the back's rest.
+            assert o.kind != "chair" or faces[o.name] == 6 * 6
 
 
 # --- a tiny render pair ---------------------------------------------------------------------
