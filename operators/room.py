@@ -250,6 +250,43 @@ class DIMRED_OT_object_from_photo(bpy.types.Operator):
         return self.execute(context)
 
 
+class DIMRED_OT_fit_box(bpy.types.Operator):
+    bl_idname = "dimred.fit_box"
+    bl_label = "Fit Box to Photo"
+    bl_description = ("Refit the marked box proxy to the object's outline in the panorama: its place, turn and each "
+                      "of its width, depth and height (Align to Photo keeps its proportions)")
+    bl_options = {'REGISTER', 'UNDO'}
+
+    @classmethod
+    def poll(cls, context: bpy.types.Context) -> bool:
+        target = context.scene.dimred.target
+        if target is None or target.type != 'MESH':
+            cls.poll_message_set("Mark the box proxy to remove first")
+            return False
+        return True
+
+    def execute(self, context: bpy.types.Context) -> set[str]:
+        from ..addon.blender import reader, room_builder
+        from ..addon.roommatch.object_box import refit_box
+
+        scene = context.scene
+        obj = scene.dimred.target
+        corners = np.array([tuple(obj.matrix_world @ v.co) for v in obj.data.vertices])
+        try:
+            box = refit_box(reader.panorama_pixels(scene), corners, probe=reader.probe_center(scene),
+                            floor_z=room_builder.floor_height(scene),
+                            rotation=room_builder.panorama_rotation(scene))
+        except DimredError as error:
+            self.report({'ERROR'}, str(error))
+            return {'CANCELLED'}
+        room_builder.reshape_box(obj, box.corners())
+        scene.dimred.mark(obj)
+        width, depth, tall = box.size
+        self.report({'INFO'}, f"'{obj.name}': {width:.2f} × {depth:.2f} × {tall:.2f} m, turned "
+                              f"{np.degrees(box.turn):.1f}°, {100 * box.agreement:.0f} % of the outline agrees")
+        return {'FINISHED'}
+
+
 class DIMRED_OT_room_remove_corner(bpy.types.Operator):
     bl_idname = "dimred.room_remove_corner"
     bl_label = "Remove Corner"
@@ -376,7 +413,7 @@ def _world_size(scene: bpy.types.Scene) -> tuple[int, int] | None:
 
 
 classes = (DIMRED_OT_match_room, DIMRED_OT_room_click, DIMRED_OT_room_suggest, DIMRED_OT_object_from_photo,
-           DIMRED_OT_room_remove_corner, DIMRED_OT_room_clear, DIMRED_OT_room_load_clicks, DIMRED_OT_room_save_clicks,
-           DIMRED_OT_show_room_diagnostics)
+           DIMRED_OT_fit_box, DIMRED_OT_room_remove_corner, DIMRED_OT_room_clear, DIMRED_OT_room_load_clicks,
+           DIMRED_OT_room_save_clicks, DIMRED_OT_show_room_diagnostics)
 
 register, unregister = bpy.utils.register_classes_factory(classes)

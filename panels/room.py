@@ -53,7 +53,9 @@ class DIMRED_PT_room(bpy.types.Panel):
         row = layout.row(align=True)
         row.operator("dimred.match_room", icon='MESH_CUBE')
         row.operator("dimred.match_room", text="Snap to Photo", icon='SNAP_ON').snap = True
-        layout.operator("dimred.object_from_photo", icon='CUBE')
+        row = layout.row(align=True)
+        row.operator("dimred.object_from_photo", icon='CUBE')
+        row.operator("dimred.fit_box", icon='FULLSCREEN_ENTER')
         if room.problem:
             layout.label(text=room.problem, icon='ERROR')
         _fit(layout, room.summary)

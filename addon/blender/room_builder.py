@@ -103,13 +103,31 @@ def floor_height(scene: bpy.types.Scene) -> float:
 def box_object(scene: bpy.types.Scene, name: str, corners: np.ndarray) -> bpy.types.Object:
     """A new box mesh object `name` (or `name`.001 ...) with the 8 `corners` (bottom four counter-
     clockwise, then the top four), its faces' normals outwards."""
+    obj = bpy.data.objects.new(name, _box_mesh(name, corners))
+    scene.collection.objects.link(obj)
+    return obj
+
+
+def reshape_box(obj: bpy.types.Object, corners: np.ndarray) -> None:
+    """Give the box proxy `obj` the world `corners` (as `box_object` takes them): a new mesh with
+    the old one's materials, the object's transform cleared to the identity."""
+    mesh = _box_mesh(obj.data.name, corners)
+    old = obj.data
+    for material in old.materials:
+        mesh.materials.append(material)
+    obj.parent = None
+    obj.matrix_world = ((1.0, 0.0, 0.0, 0.0), (0.0, 1.0, 0.0, 0.0), (0.0, 0.0, 1.0, 0.0), (0.0, 0.0, 0.0, 1.0))
+    obj.data = mesh
+    if old.users == 0:
+        bpy.data.meshes.remove(old)
+
+
+def _box_mesh(name: str, corners: np.ndarray) -> bpy.types.Mesh:
     faces = ((0, 3, 2, 1), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7))
     mesh = bpy.data.meshes.new(name)
     mesh.from_pydata([tuple(v) for v in np.asarray(corners, dtype=np.float64).tolist()], [], faces)
     mesh.validate()
-    obj = bpy.data.objects.new(name, mesh)
-    scene.collection.objects.link(obj)
-    return obj
+    return mesh
 
 
 def _put_mesh(scene: bpy.types.Scene, data: MeshData) -> bpy.types.Object:

@@ -19,16 +19,21 @@ from ..errors import DimredError
 from ..geometry.resample import resample_axis
 from ..segmentation.grabcut import segment_object
 from ..segmentation.masks import dilate
-from .projection import click_directions
+from .projection import click_directions, project
 
 _WORKING_WIDTH = 1024
 _WINDOW = 0.12  # half the window's side, as a share of the panorama's width (43 degrees)
 _REFINE_BAND = 0.12  # the second pass's band, as a share of the object's size in pixels
+_PROXY_BAND = 0.3  # the first pass's band around a proxy, as a share of its size in pixels
 _SEED = 1.5  # px radius of the seed disc at the click, on the coarsest copy the segmentation halves to
 _COARSEST_BAND = 16  # the widest band `segment_object` decides without halving
 _MIN_PIXELS = 30
 _STEPS = np.array([0.05, 0.05, 0.1, 0.1, 0.1, np.radians(5.0)])  # metres, log-size, radians
-_FINEST = 1.0 / 32.0  # of the first steps
+# The search's moves: each parameter alone, and one size traded against another (a deeper, lower
+# box shows much the same outline: alone, neither move would be taken).
+_DIRECTIONS = np.concatenate([np.diag(_STEPS), _STEPS * np.array([[0, 0, 0, 1, -1, 0], [0, 0, 1, 0, -1, 0],
+                                                                   [0, 0, 1, -1, 0, 0]])])
+_FINEST = 1.0 / 32.0  # the last steps, a share of the first
 _MAX_EVALUATIONS = 600
 
 
@@ -63,37 +68,126 @@ def box_from_click(panorama: np.ndarray, click: tuple[float, float], *, click_si
                    probe: np.ndarray, floor_z: float = 0.0, rotation: np.ndarray | None = None) -> BoxFit:
     """The box proxy of the object clicked at `click` (x, y) on a `click_size` (W, H) panorama;
     DimredError when the photograph shows no object there standing on the floor."""
+    probe, camera = _camera(probe, floor_z)
+    view = _View.around(panorama, click, click_size, rotation, _WINDOW)
+    band = view.half // 2
+    # The segmentation decides a wide band on halved copies first: the seed must survive them.
+    halvings = max(0, int(np.ceil(np.log2(band / _COARSEST_BAND))))
+    seed = (view.rows[:, None] - view.y) ** 2 + (view.cols[None, :] - view.x) ** 2 <= (_SEED * 2**halvings) ** 2
+    shown = _segment(view.image, seed, band)
+    points = _floor_points(shown, view.directions, camera)
+    if len(points) < 3:
+        raise DimredError(f"no object standing on the floor is seen at ({click[0]:g}, {click[1]:g}): click inside "
+                          "an object whose foot the panorama shows")
+    start = _first_box(points, shown, view.directions, camera)
+    return _fitted(start, shown, view.directions, camera, probe, floor_z)
+
+
+def refit_box(panorama: np.ndarray, corners: np.ndarray, *, probe: np.ndarray, floor_z: float = 0.0,
+              rotation: np.ndarray | None = None) -> BoxFit:
+    """A box proxy (`corners` (8, 3) world, standing upright) refitted to the object's outline in
+    the photograph: its place, turn and each of its three sizes (Align to Photo keeps the
+    proportions). DimredError when the corners are no upright box or the photograph shows
+    nothing there."""
+    probe, camera = _camera(probe, floor_z)
+    params = _box_params(np.asarray(corners, dtype=np.float64), probe, floor_z)
+    centre = np.array([params[0], params[1], -camera + 0.5 * np.exp(params[4])])
+    height, width = panorama.shape[:2]
+    at = project(centre, width, height, rotation)
+    reach = float(np.linalg.norm(np.exp(params[2:5]))) / max(float(np.linalg.norm(centre)), 1e-9)
+    view = _View.around(panorama, tuple(at), (width, height), rotation, max(_WINDOW, reach / np.pi))
+    proxy = silhouette(params, view.directions, camera)
+    if proxy.sum() < _MIN_PIXELS:
+        raise DimredError("the box is too small in the panorama to refit it")
+    extent = max(np.ptp(np.nonzero(proxy)[0]), np.ptp(np.nonzero(proxy)[1]))
+    # A band as wide as a box modelled by eye may be off (its height by a fifth, say).
+    shown = _segment(view.image, proxy, max(2, int(_PROXY_BAND * extent)))
+    # From the proxy as modelled, and from the outline's own first box: a turn off by several
+    # degrees can hold the search in a nearby optimum.
+    fits = [_fitted(_front(params), shown, view.directions, camera, probe, floor_z)]
+    points = _floor_points(shown, view.directions, camera)
+    if len(points) >= 3:
+        fits.append(_fitted(_first_box(points, shown, view.directions, camera), shown, view.directions, camera,
+                            probe, floor_z))
+    return max(fits, key=lambda fit: fit.agreement)
+
+
+@dataclass(frozen=True)
+class _View:
+    """A square window of the panorama at the working width around pixel (x, y): its image, its
+    rows and columns (the columns may run past the seam) and its pixels' directions."""
+
+    image: np.ndarray
+    rows: np.ndarray
+    cols: np.ndarray
+    directions: np.ndarray
+    x: float
+    y: float
+    half: int
+
+    @classmethod
+    def around(cls, panorama: np.ndarray, at: tuple[float, float], size: tuple[int, int],
+               rotation: np.ndarray | None, share: float) -> _View:
+        image = np.asarray(panorama, dtype=np.float32)
+        width = min(_WORKING_WIDTH, image.shape[1])
+        height = width // 2
+        image = resample_axis(resample_axis(image, height, axis=0), width, axis=1)
+        x, y = (np.asarray(at, dtype=np.float64) + 0.5) * (width / size[0], height / size[1]) - 0.5
+        half = int(min(share, 0.45) * width)
+        rows = np.arange(max(0, round(float(y)) - half), min(height, round(float(y)) + half + 1))
+        cols = np.arange(round(float(x)) - half, round(float(x)) + half + 1)
+        directions = click_directions(np.stack(np.broadcast_arrays(cols[None, :], rows[:, None]), axis=-1),
+                                      width, height, rotation)
+        return cls(image[rows[:, None], np.mod(cols, width)[None, :]], rows, cols, directions, float(x), float(y),
+                   half)
+
+
+def _camera(probe: np.ndarray, floor_z: float) -> tuple[np.ndarray, float]:
     probe = np.asarray(probe, dtype=np.float64)
     camera = float(probe[2] - floor_z)
     if not camera > 0.0:
         raise DimredError(f"the probe centre is not above the floor ({camera:.3g} m): match the room first")
-    image = np.asarray(panorama, dtype=np.float32)
-    width = min(_WORKING_WIDTH, image.shape[1])
-    height = width // 2
-    image = resample_axis(resample_axis(image, height, axis=0), width, axis=1)
-    x, y = (np.asarray(click, dtype=np.float64) + 0.5) * (width / click_size[0], height / click_size[1]) - 0.5
-    half = int(_WINDOW * width)
-    col0, row0 = round(float(x)) - half, max(0, round(float(y)) - half)
-    rows = np.arange(row0, min(height, round(float(y)) + half + 1))
-    cols = np.arange(col0, col0 + 2 * half + 1)
-    window = image[rows[:, None], np.mod(cols, width)[None, :]]
-    # Pixel directions in the probe's frame, the window's columns as the panorama's.
-    directions = click_directions(np.stack(np.broadcast_arrays(cols[None, :], rows[:, None]), axis=-1),
-                                  width, height, rotation)
-    band = half // 2
-    # The segmentation decides a wide band on halved copies first: the seed must survive them.
-    halvings = max(0, int(np.ceil(np.log2(band / _COARSEST_BAND))))
-    seed = (rows[:, None] - y) ** 2 + (cols[None, :] - x) ** 2 <= (_SEED * 2**halvings) ** 2
-    shown = _segment(window, seed, band)
-    points = _floor_points(shown, directions, camera)
-    if len(points) < 3:
-        raise DimredError(f"no object standing on the floor is seen at ({click[0]:g}, {click[1]:g}): click inside "
-                          "an object whose foot the panorama shows")
-    start = _first_box(points, shown, directions, camera)
-    params, agreement = _search(start, shown, directions, camera)
+    return probe, camera
+
+
+def _fitted(start: np.ndarray, shown: np.ndarray, directions: np.ndarray, camera: float, probe: np.ndarray,
+            floor_z: float) -> BoxFit:
+    # The search looks at the outline's bounding box grown by half its size each way: a box
+    # whose silhouette reaches past it agrees less anyway.
+    rows, cols = np.nonzero(shown)
+    pad_r, pad_c = (np.ptp(rows) + 1) // 2, (np.ptp(cols) + 1) // 2
+    crop = (slice(max(0, rows.min() - pad_r), rows.max() + pad_r + 1),
+            slice(max(0, cols.min() - pad_c), cols.max() + pad_c + 1))
+    params, agreement = _search(start, shown[crop], directions[crop], camera)
     return BoxFit(bottom=np.array([probe[0] + params[0], probe[1] + params[1], floor_z]),
                   size=np.exp(params[2:5]), turn=float(params[5]), agreement=agreement,
                   outline_pixels=int(shown.sum()))
+
+
+def _box_params(corners: np.ndarray, probe: np.ndarray, floor_z: float) -> np.ndarray:
+    """`silhouette`'s parameters of an upright box given by its 8 corners (any order)."""
+    if corners.shape != (8, 3):
+        raise DimredError(f"a box has 8 corners, this mesh {len(corners)}: Fit Box works on box proxies only")
+    order = np.argsort(corners[:, 2])
+    bottom, top = corners[order[:4]], corners[order[4:]]
+    tall = float(top[:, 2].mean() - bottom[:, 2].mean())
+    centre = bottom[:, :2].mean(axis=0)
+    spokes = bottom[:, :2] - centre
+    ring = bottom[np.argsort(np.arctan2(spokes[:, 1], spokes[:, 0])), :2]  # round the footprint
+    side, other = ring[1] - ring[0], ring[2] - ring[1]
+    width, depth = float(np.linalg.norm(side)), float(np.linalg.norm(other))
+    flat = np.ptp(bottom[:, 2]) <= 1e-3 * max(tall, 1e-9) + 1e-6 and np.ptp(top[:, 2]) <= 1e-3 * tall + 1e-6
+    # A rectangle: sides at right angles, opposite sides equal; the top straight above it.
+    above = np.linalg.norm(top[:, None, :2] - ring[None, :, :], axis=2).min(axis=1)
+    square = (abs(float(side @ other)) <= 1e-3 * width * depth + 1e-9
+              and np.allclose(ring[2] - ring[3], side, atol=1e-4 * (width + depth))
+              and bool(np.all(above <= 1e-3 * (width + depth))))
+    if not (tall > 0 and width > 0 and depth > 0 and flat and square):
+        raise DimredError("the proxy is not an upright box: Fit Box works on box proxies only")
+    if abs(float(bottom[:, 2].mean()) - floor_z) > 0.02:
+        raise DimredError(f"the box stands {bottom[:, 2].mean() - floor_z:+.3f} m off the floor: put it on the floor")
+    turn = float(np.arctan2(side[1], side[0]))
+    return np.array([centre[0] - probe[0], centre[1] - probe[1], np.log(width), np.log(depth), np.log(tall), turn])
 
 
 def silhouette(params: np.ndarray, directions: np.ndarray, camera: float) -> np.ndarray:
@@ -116,9 +210,10 @@ def silhouette(params: np.ndarray, directions: np.ndarray, camera: float) -> np.
 
 
 def _segment(window: np.ndarray, seed: np.ndarray, band: int) -> np.ndarray:
-    """The object at the seed: segmented in a `band` half the window wide around the seed (its
-    background sampled beyond that band; no pull towards the seed's side, which would keep the
-    object as small as the seed), then again in a narrow band around what was found."""
+    """The object at the seed (a disc at a click, or a proxy's silhouette): segmented in a wide
+    `band` around the seed (its background sampled beyond that band; no pull towards the seed's
+    side, which would keep the object as small as the seed), then again in a narrow band around
+    what was found."""
     if float(np.ptp(window)) <= 1e-6 * max(float(window.max()), 1e-12):
         raise DimredError("the panorama is flat around the click: there is no object to outline")
     part = _holding(segment_object(window, seed, band=band, prior=0.0).object, seed)
@@ -167,6 +262,17 @@ def _first_box(points: np.ndarray, shown: np.ndarray, directions: np.ndarray, ca
                      float(np.arctan2(axis[1], axis[0]))])
 
 
+def _front(params: np.ndarray) -> np.ndarray:
+    """Front-face parameters of box parameters (the inverse of `_centred`)."""
+    x, y, lw, ld, lh, turn = params
+    axes = np.array([[np.cos(turn), np.sin(turn)], [-np.sin(turn), np.cos(turn)]])
+    extents = np.exp([lw, ld])
+    away = np.array([x, y]) / max(float(np.hypot(x, y)), 1e-9)
+    k = int(np.argmax(np.abs(axes @ away)))
+    front = np.array([x, y]) - axes[k] * np.sign(axes[k] @ away) * extents[k] / 2.0
+    return np.array([front[0], front[1], lw, ld, lh, turn])
+
+
 def _centred(front: np.ndarray) -> np.ndarray:
     """Box parameters (bottom centre) from front-face parameters: the bottom centre of the side
     facing the probe instead of the box's, so that a change of depth keeps that side in place."""
@@ -187,19 +293,18 @@ def _search(params: np.ndarray, shown: np.ndarray, directions: np.ndarray, camer
         return float(np.count_nonzero(box & shown)) / max(float(np.count_nonzero(box | shown)), 1.0)
 
     best = score(params)
-    steps = _STEPS.copy()
+    scale = 1.0
     evaluations = 1
-    while steps[0] > _STEPS[0] * _FINEST and evaluations < _MAX_EVALUATIONS:
+    while scale > _FINEST and evaluations < _MAX_EVALUATIONS:
         improved = False
-        for i in range(len(params)):
+        for direction in _DIRECTIONS:
             for sign in (1.0, -1.0):
-                trial = params.copy()
-                trial[i] += sign * steps[i]
+                trial = params + sign * scale * direction
                 value = score(trial)
                 evaluations += 1
                 if value > best:
                     params, best, improved = trial, value, True
                     break
         if not improved:
-            steps /= 2.0
+            scale /= 2.0
     return _centred(params), best

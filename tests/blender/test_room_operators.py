@@ -174,3 +174,27 @@ def test_suggest_room_says_when_it_finds_nothing(registered, tmp_path: Path) -> 
     room_builder.show_panorama(bpy.context.scene, str(hdri))
     assert bpy.ops.dimred.room_suggest() == {'CANCELLED'}
     assert len(bpy.context.scene.dimred_room.corners) == 0
+
+
+def test_fit_box_refits_each_size_of_the_marked_box(panorama_room: np.ndarray, tmp_path: Path) -> None:
+    from addon.blender import room_builder
+    from addon.roommatch.object_box import BoxFit
+    from tests.engine.roommatch.room_truth import with_box
+
+    truth = np.array([1.8, 0.6, np.log(0.8), np.log(0.7), np.log(0.95), np.radians(20.0)])
+    hdri = tmp_path / "chair.exr"
+    tiny_scene.write_exr(hdri, with_box(flat_panorama(BOX, CEILING, PROBE, 1024, 512), truth, 1.5, (0.7, 0.6, 0.1)))
+    scene = bpy.context.scene
+    room_builder.show_panorama(scene, str(hdri))
+    room_builder.set_probe_center(scene, PROBE)
+    # Modelled by eye: 10 cm off, turned 8 degrees too far, 0.8 m high.
+    guess = BoxFit(bottom=np.array([1.9, 0.55, 0.0]), size=np.array([0.7, 0.7, 0.8]), turn=np.radians(28.0),
+                   agreement=0.0, outline_pixels=0)
+    scene.dimred.mark(room_builder.box_object(scene, "Chair", guess.corners()))
+    assert bpy.ops.dimred.fit_box() == {'FINISHED'}
+    corners = _vertices("Chair")
+    assert corners[:, 2].max() == pytest.approx(0.95, rel=0.05)
+    assert corners[:, :2].mean(axis=0) == pytest.approx(truth[:2], abs=0.05)
+    bpy.data.objects["Chair"].data.vertices[5].co.x += 0.2  # no longer a box
+    with pytest.raises(RuntimeError, match="not an upright box"):
+        bpy.ops.dimred.fit_box()
