@@ -102,7 +102,30 @@ class DIMRED_OT_match_room(bpy.types.Operator):
         return {'FINISHED'}
 
 
-class DIMRED_OT_room_click(bpy.types.Operator):
+class PanoramaClick:
+    """A click's place in the panorama, for scripts (x, y on a width x height panorama) or taken
+    from the mouse in the Image Editor showing it."""
+
+    x: FloatProperty(name="Column", description="Pixels from the left, pixel centres at whole numbers")
+    y: FloatProperty(name="Row", description="Pixels from the top, pixel centres at whole numbers")
+    width: IntProperty(name="Width", description="The panorama's width the click was made on (0: the world's)", min=0)
+    height: IntProperty(name="Height", description="The panorama's height the click was made on (0: the world's)",
+                        min=0)
+
+    def size(self, scene: bpy.types.Scene) -> tuple[int, int]:
+        size = (self.width, self.height) if self.width and self.height else _world_size(scene)
+        if size is None:
+            raise DimredError("give the panorama's width and height: the world shows no panorama")
+        return size
+
+    def take_mouse(self, context: bpy.types.Context, event: bpy.types.Event) -> None:
+        image = context.space_data.image
+        u, v = context.region.view2d.region_to_view(event.mouse_region_x, event.mouse_region_y)
+        self.width, self.height = image.size
+        self.x, self.y = u * self.width - 0.5, (1.0 - v) * self.height - 0.5
+
+
+class DIMRED_OT_room_click(PanoramaClick, bpy.types.Operator):
     bl_idname = "dimred.room_click"
     bl_label = "Click Room"
     bl_description = ("Click the floor's corners in order round the room in the Image Editor showing the panorama "
@@ -111,16 +134,13 @@ class DIMRED_OT_room_click(bpy.types.Operator):
     bl_options = {'REGISTER', 'UNDO'}
 
     kind: EnumProperty(name="Kind", items=KIND_ITEMS, default='FLOOR')
-    x: FloatProperty(name="Column", description="Pixels from the left, pixel centres at whole numbers")
-    y: FloatProperty(name="Row", description="Pixels from the top, pixel centres at whole numbers")
-    width: IntProperty(name="Width", description="The panorama's width in pixels (0: the world's)", min=0)
-    height: IntProperty(name="Height", description="The panorama's height in pixels (0: the world's)", min=0)
 
     def execute(self, context: bpy.types.Context) -> set[str]:
         room = context.scene.dimred_room
-        size = (self.width, self.height) if self.width and self.height else _world_size(context.scene)
-        if size is None:
-            self.report({'ERROR'}, "give the panorama's width and height: the world shows no panorama")
+        try:
+            size = self.size(context.scene)
+        except DimredError as error:
+            self.report({'ERROR'}, str(error))
             return {'CANCELLED'}
         if room.corners and (room.width, room.height) != size:
             self.report({'ERROR'}, f"the clicks so far were made on a {room.width} × {room.height} panorama, not "
@@ -151,10 +171,7 @@ class DIMRED_OT_room_click(bpy.types.Operator):
             bpy.ops.dimred.match_room()
             return {'FINISHED'}
         if event.type == 'LEFTMOUSE' and event.value == 'PRESS':
-            image = context.space_data.image
-            u, v = context.region.view2d.region_to_view(event.mouse_region_x, event.mouse_region_y)
-            self.width, self.height = image.size
-            self.x, self.y = u * self.width - 0.5, (1.0 - v) * self.height - 0.5
+            self.take_mouse(context, event)
             room = context.scene.dimred_room
             shift_kind = 'LENGTH_END' if tuple(room.length_start) != (0.0, 0.0) else 'LENGTH_START'
             self.kind = 'CEILING' if event.ctrl else shift_kind if event.shift else 'FLOOR'
@@ -194,18 +211,13 @@ class DIMRED_OT_room_suggest(bpy.types.Operator):
         return {'FINISHED'}
 
 
-class DIMRED_OT_object_from_photo(bpy.types.Operator):
+class DIMRED_OT_object_from_photo(PanoramaClick, bpy.types.Operator):
     bl_idname = "dimred.object_from_photo"
     bl_label = "Object from Photo"
     bl_description = ("Click inside an object standing on the floor in the Image Editor showing the panorama: a box "
                       "proxy is fitted to its outline (place, width, depth, height, turn) and marked for removal")
     bl_options = {'REGISTER', 'UNDO'}
 
-    x: FloatProperty(name="Column", description="Pixels from the left, pixel centres at whole numbers")
-    y: FloatProperty(name="Row", description="Pixels from the top, pixel centres at whole numbers")
-    width: IntProperty(name="Width", description="The panorama's width the click was made on (0: the world's)", min=0)
-    height: IntProperty(name="Height", description="The panorama's height the click was made on (0: the world's)",
-                        min=0)
     name: StringProperty(name="Name", description="The new proxy's name", default="Object")
 
     def execute(self, context: bpy.types.Context) -> set[str]:
@@ -214,9 +226,7 @@ class DIMRED_OT_object_from_photo(bpy.types.Operator):
 
         scene = context.scene
         try:
-            size = (self.width, self.height) if self.width and self.height else _world_size(scene)
-            if size is None:
-                raise DimredError("the world shows no panorama: add an Environment Texture with the HDRI")
+            size = self.size(scene)
             panorama, probe = reader.panorama_pixels(scene), reader.probe_center(scene)
             rotation = room_builder.panorama_rotation(scene)
             box = box_from_click(panorama, (self.x, self.y), click_size=size, probe=probe,
@@ -234,9 +244,7 @@ class DIMRED_OT_object_from_photo(bpy.types.Operator):
             clicks = room.clicks()
             fitted = fit_room(clicks, rotation=rotation, origin=tuple(probe[:2]), ceiling_height=room.ceiling_height)
             show_room_picture(room_picture(panorama, fitted, clicks, boxes=(box.corners(),), rotation=rotation))
-        width, depth, tall = box.size
-        self.report({'INFO'}, f"'{obj.name}': {width:.2f} × {depth:.2f} × {tall:.2f} m, turned "
-                              f"{np.degrees(box.turn):.1f}°, {100 * box.agreement:.0f} % of the outline agrees")
+        self.report({'INFO'}, _box_line(obj.name, box))
         return {'FINISHED'}
 
     def invoke(self, context: bpy.types.Context, event: bpy.types.Event) -> set[str]:
@@ -244,9 +252,7 @@ class DIMRED_OT_object_from_photo(bpy.types.Operator):
         if context.area is None or context.area.type != 'IMAGE_EDITOR' or space.image is None:
             self.report({'ERROR'}, "show the panorama in an Image Editor and click the object there")
             return {'CANCELLED'}
-        u, v = context.region.view2d.region_to_view(event.mouse_region_x, event.mouse_region_y)
-        self.width, self.height = space.image.size
-        self.x, self.y = u * self.width - 0.5, (1.0 - v) * self.height - 0.5
+        self.take_mouse(context, event)
         return self.execute(context)
 
 
@@ -281,9 +287,7 @@ class DIMRED_OT_fit_box(bpy.types.Operator):
             return {'CANCELLED'}
         room_builder.reshape_box(obj, box.corners())
         scene.dimred.mark(obj)
-        width, depth, tall = box.size
-        self.report({'INFO'}, f"'{obj.name}': {width:.2f} × {depth:.2f} × {tall:.2f} m, turned "
-                              f"{np.degrees(box.turn):.1f}°, {100 * box.agreement:.0f} % of the outline agrees")
+        self.report({'INFO'}, _box_line(obj.name, box))
         return {'FINISHED'}
 
 
@@ -401,6 +405,12 @@ class DIMRED_OT_show_room_diagnostics(bpy.types.Operator):
             self.report({'WARNING'}, "no window to show the picture in")
             return {'CANCELLED'}
         return {'FINISHED'}
+
+
+def _box_line(name: str, box) -> str:
+    width, depth, tall = box.size
+    return (f"'{name}': {width:.2f} × {depth:.2f} × {tall:.2f} m, turned {np.degrees(box.turn):.1f}°, "
+            f"{100 * box.agreement:.0f} % of the outline agrees")
 
 
 def _world_size(scene: bpy.types.Scene) -> tuple[int, int] | None:
