@@ -6,6 +6,8 @@ room leaves the room as it was and puts the reason in `problem`, which the panel
 """
 from __future__ import annotations
 
+import json
+
 import bpy
 from bpy.props import (
     BoolProperty,
@@ -36,11 +38,12 @@ def _refit(item: bpy.types.PropertyGroup, context: bpy.types.Context) -> None:
     from ..addon.blender import room_builder
 
     try:
-        room_builder.match_room(scene, room.clicks(), ceiling_height=room.ceiling_height)
+        fitted = room_builder.match_room(scene, room.clicks(), ceiling_height=room.ceiling_height)
     except DimredError as error:
         room.problem = str(error)
     else:
         room.problem = ""
+        room.summary = json.dumps(fitted.summary())
 
 
 def _click(name: str, description: str) -> FloatVectorProperty:

@@ -74,6 +74,7 @@ def test_moving_a_click_refits_the_room(panorama_room: np.ndarray) -> None:
     assert np.min(np.linalg.norm(floor[:, :2] - (-2.5, -1.5), axis=1)) < 0.02
     scene.dimred_room.camera_height = 2.0  # and a new height scales the room about the probe at once
     assert np.min(np.linalg.norm(_vertices("Floor")[:, :2] - (-2.5 * 4 / 3, -2.0), axis=1)) < 0.03
+    assert json.loads(scene.dimred_room.summary)["camera_height_m"] == 2.0
 
 
 def test_bad_clicks_change_nothing(panorama_room: np.ndarray) -> None:
