@@ -19,7 +19,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..light.radiosity import LUMA
-from ..segmentation.masks import box_mean, dilate, erode
+from ..segmentation.masks import box_mean, box_sum, dilate, erode
 from .shift_map import hole_extent
 
 # Feature bins: log luminance in steps of 0.15, chromaticity (r, g) in steps of 0.03: about what
@@ -28,7 +28,9 @@ _STEPS = np.array([0.15, 0.03, 0.03])
 _SECTORS = 8  # directions around the hole
 _MIN_SECTOR_CELLS = 16  # cells a direction needs around the hole to count
 _PRESENT = 0.01  # share of a direction's cells a colour needs there (at least 2 cells)
-_AROUND = 0.75  # share of the counted directions a colour must be present in
+_AROUND = (0.75, 0.625, 0.5)  # shares of the counted directions a colour must be present in, strictest first
+_RING_MATCH = 0.5  # the share of the ring's outer half that must match for a stricter share to hold
+_SCATTER_RADIUS = 3  # cells: most of the known cells this near an exemplar cell must be exemplar too
 _MIN_SHARE_WARN = 0.5  # below this share of the seen cells, the surface is mostly something else
 
 
@@ -64,7 +66,8 @@ def border_material(image: np.ndarray, known: np.ndarray, hole: np.ndarray, *, m
     around = known & near & ~dilate(hole, reach // 2)
     if not around.any():
         return undecided
-    mean, _ = box_mean(np.concatenate([np.log(np.maximum(image @ LUMA, 1e-4))[..., None],
+    log_y = np.log(np.maximum(image @ LUMA, 1e-4))
+    mean, _ = box_mean(np.concatenate([log_y[..., None],
                                        image[..., :2] / np.maximum(image.sum(axis=-1, keepdims=True), 1e-6)],
                                       axis=-1), known, 1)
     bins = np.floor(mean / _STEPS).astype(np.int64)
@@ -82,12 +85,25 @@ def border_material(image: np.ndarray, known: np.ndarray, hole: np.ndarray, *, m
         return undecided
     near_counts = _neighbour_sum(counts.reshape(*shape, _SECTORS))
     present = near_counts.reshape(-1, _SECTORS) >= np.maximum(_PRESENT * per_sector, 2.0)
-    common = (present & counted).sum(axis=1) >= _AROUND * counted.sum()
-    matching = known & common[flat]
+    directions = (present & counted).sum(axis=1)[flat]
+    # A floor's light and gloss change its colour from one side of the hole to the other: where
+    # too little of the ring matches colours found all around it, colours found in fewer
+    # directions are taken too, down to half of them (a rug on one side stays out).
+    for share in _AROUND:
+        matching = known & (directions >= share * counted.sum())
+        if (matching & around).sum() >= _RING_MATCH * around.sum():
+            break
     # Cells between a texture's colours (a tile's edge, a seam) may match nothing on their own:
-    # only what is wider than a line counts as something else, with a cell of margin around it.
-    other = dilate(dilate(erode(known & ~matching, 1), 1), 1) & known
+    # only what is wider than a line counts as something else, with a cell of margin around it,
+    # unless a cell is darker or brighter than any of the material's (a rug's black stripe).
+    lo, hi = np.quantile(log_y[matching & around], [0.005, 0.995]) if (matching & around).any() else (0.0, 0.0)
+    beyond = known & ~matching & ((log_y < lo - _STEPS[0]) | (log_y > hi + _STEPS[0]))
+    beyond &= box_sum(beyond, 1) >= 3  # a stripe or a spot, not a pixel of noise
+    other = (dilate(dilate(erode(known & ~matching, 1), 1), 1) | dilate(beyond, 1)) & known
     exemplar = known & ~other
+    # and not scattered in something else (a rug's stripes whose blends pass for wood)
+    nearby, _ = box_mean(exemplar[..., None].astype(np.float64), known, _SCATTER_RADIUS)
+    exemplar &= nearby[..., 0] >= 0.5
     if exemplar.sum() < min_cells:
         return replace(undecided, decided=True)
     return Material(exemplar=exemplar, replaced=near & other, source="border material",
