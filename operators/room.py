@@ -206,7 +206,10 @@ class DIMRED_OT_room_suggest(bpy.types.Operator):
         room = scene.dimred_room
         camera = room.camera_height
         room.load(found.clicks)
-        room.camera_height = camera  # the suggestion has no scale: the height set stays
+        # The suggestion has no scale: the height set stays. Nothing is built until Match Room.
+        room.updating = True
+        room.camera_height, room.matched = camera, False
+        room.updating = False
         self.report({'INFO'}, found.message + ": check them, then Match Room")
         return {'FINISHED'}
 
