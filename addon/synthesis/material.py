@@ -27,9 +27,14 @@ from .shift_map import hole_extent
 _STEPS = np.array([0.15, 0.03, 0.03])
 _SECTORS = 8  # directions around the hole
 _MIN_SECTOR_CELLS = 16  # cells a direction needs around the hole to count
+# Fewer directions or cells around the hole than these tell no material apart from a chance
+# patch of light (a 64x32 panorama's floor): the whole surface is the exemplar then.
+_MIN_SECTORS = 3
+_MIN_RING_CELLS = 400
 _PRESENT = 0.01  # share of a direction's cells a colour needs there (at least 2 cells)
 _AROUND = (0.75, 0.625, 0.5)  # shares of the counted directions a colour must be present in, strictest first
 _RING_MATCH = 0.5  # the share of the ring's outer half that must match for a stricter share to hold
+_MIN_BEYOND = 0.01  # share of the seen cells thin things of no material colour must make to be left out
 _SCATTER_RADIUS = 3  # cells: most of the known cells this near an exemplar cell must be exemplar too
 _MIN_SHARE_WARN = 0.5  # below this share of the seen cells, the surface is mostly something else
 
@@ -81,7 +86,7 @@ def border_material(image: np.ndarray, known: np.ndarray, hole: np.ndarray, *, m
     np.add.at(counts, (flat[rows, cols], sector), 1.0)
     per_sector = counts.sum(axis=0)
     counted = per_sector >= _MIN_SECTOR_CELLS
-    if not counted.any():
+    if counted.sum() < _MIN_SECTORS or per_sector.sum() < _MIN_RING_CELLS:
         return undecided
     near_counts = _neighbour_sum(counts.reshape(*shape, _SECTORS))
     present = near_counts.reshape(-1, _SECTORS) >= np.maximum(_PRESENT * per_sector, 2.0)
@@ -99,14 +104,19 @@ def border_material(image: np.ndarray, known: np.ndarray, hole: np.ndarray, *, m
     lo, hi = np.quantile(log_y[matching & around], [0.005, 0.995]) if (matching & around).any() else (0.0, 0.0)
     beyond = known & ~matching & ((log_y < lo - _STEPS[0]) | (log_y > hi + _STEPS[0]))
     beyond &= box_sum(beyond, 1) >= 3  # a stripe or a spot, not a pixel of noise
-    other = (dilate(dilate(erode(known & ~matching, 1), 1), 1) | dilate(beyond, 1)) & known
-    exemplar = known & ~other
+    if beyond.sum() < _MIN_BEYOND * known.sum():
+        # a few odd cells would be copied nowhere visible, but leaving them out breaks the lines
+        # the planks' structure draws between their visible ends
+        beyond[:] = False
+    wide = dilate(dilate(erode(known & ~matching, 1), 1), 1) & known
+    exemplar = known & ~wide & ~(dilate(beyond, 1) & known)
     # and not scattered in something else (a rug's stripes whose blends pass for wood)
     nearby, _ = box_mean(exemplar[..., None].astype(np.float64), known, _SCATTER_RADIUS)
     exemplar &= nearby[..., 0] >= 0.5
     if exemplar.sum() < min_cells:
         return replace(undecided, decided=True)
-    return Material(exemplar=exemplar, replaced=near & other, source="border material",
+    # Only what is wider than a line is repainted beside the hole: a thin stripe is only left out.
+    return Material(exemplar=exemplar, replaced=near & wide, source="border material",
                     share=float(exemplar.sum() / known.sum()))
 
 
