@@ -233,7 +233,8 @@ class DIMRED_OT_object_from_photo(PanoramaClick, bpy.types.Operator):
             panorama, probe = reader.panorama_pixels(scene), reader.probe_center(scene)
             rotation = room_builder.panorama_rotation(scene)
             box = box_from_click(panorama, (self.x, self.y), click_size=size, probe=probe,
-                                 floor_z=room_builder.floor_height(scene), rotation=rotation)
+                                 floor_z=room_builder.floor_height(scene), rotation=rotation,
+                                 inside=room_builder.floor_polygon(scene))
         except DimredError as error:
             self.report({'ERROR'}, str(error))
             return {'CANCELLED'}
@@ -284,7 +285,7 @@ class DIMRED_OT_fit_box(bpy.types.Operator):
         try:
             box = refit_box(reader.panorama_pixels(scene), corners, probe=reader.probe_center(scene),
                             floor_z=room_builder.floor_height(scene),
-                            rotation=room_builder.panorama_rotation(scene))
+                            rotation=room_builder.panorama_rotation(scene), inside=room_builder.floor_polygon(scene))
         except DimredError as error:
             self.report({'ERROR'}, str(error))
             return {'CANCELLED'}

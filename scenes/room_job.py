@@ -1,7 +1,7 @@
 """`python -m scenes.room_job DIR`: render the `RoomScene` in DIR/room.json to DIR/panorama.exr.
 
-Diffuse walls, a darker floor, a lighter ceiling and a dark door quad 5 mm in front of its wall,
-lit by one area lamp under the ceiling; few samples and bounces: the render is looked at for
+Diffuse walls, a darker floor, a lighter ceiling, a dark door quad 5 mm in front of its wall and
+yellow boxes on the floor, lit by one area lamp under the ceiling; few samples and bounces: the render is looked at for
 its edges, not its light. The camera is the ground-truth renders' panoramic camera
 (`scenes.build`), so the render is the panorama the world shows through its Mapping rotation.
 """
@@ -36,6 +36,14 @@ def build_room(room: RoomScene) -> None:
     inwards = np.array([-(b - a)[1], (b - a)[0]]) / np.linalg.norm(b - a)  # left of a counter-clockwise wall
     door[:, :2] += 0.005 * inwards
     _mesh_object(scene, "Door", [tuple(p) for p in door], [(0, 3, 2, 1)], _diffuse("Door", (0.12, 0.07, 0.04)))
+    chair = _diffuse("Box", (0.55, 0.45, 0.08))
+    for i, (x, y, w, d, h, turn) in enumerate(room.boxes):
+        a = np.radians(turn)
+        axes = np.array([[np.cos(a), np.sin(a)], [-np.sin(a), np.cos(a)]])
+        foot = np.array([[-w, -d], [w, -d], [w, d], [-w, d]]) / 2 @ axes + (x, y)
+        corners = [(px, py, z) for z in (0.0, h) for px, py in foot]
+        _mesh_object(scene, f"Box.{i:03d}", corners,
+                     [(0, 3, 2, 1), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7)], chair)
     light = bpy.data.lights.new("Lamp", "AREA")
     light.size = 0.6
     light.energy = 250.0
@@ -48,8 +56,8 @@ def build_room(room: RoomScene) -> None:
 
 def main(folder: Path) -> None:
     data = json.loads((folder / "room.json").read_text())
-    room = RoomScene(**{k: tuple(map(tuple, v)) if k == "corners" else tuple(v) if isinstance(v, list) else v
-                        for k, v in data.items()})
+    room = RoomScene(**{k: tuple(map(tuple, v)) if k in ("corners", "boxes") else tuple(v) if isinstance(v, list)
+                        else v for k, v in data.items()})
     bpy.ops.wm.read_factory_settings(use_empty=True)
     build_room(room)
     scene = bpy.context.scene

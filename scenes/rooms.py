@@ -43,9 +43,11 @@ class RoomScene:
     door_width: float = 0.9
     door_height: float = 2.0
     world_rotation_z: float = 0.0
+    # Boxes standing on the floor: (x, y, width, depth, height, turn in degrees) each.
+    boxes: tuple[tuple[float, float, float, float, float, float], ...] = ()
     width: int = 1024
     height: int = 512
-    samples: int = 16
+    samples: int = 8
 
     def key(self) -> str:
         code = "".join((Path(__file__).parent / name).read_text() for name in _SOURCES)
@@ -71,6 +73,10 @@ ROOMS: dict[str, RoomScene] = {r.name: r for r in (
     RoomScene("turned_room", ((-1.55, -2.67), (2.98, -0.56), (1.46, 2.7), (-3.07, 0.58)),
               ceiling=2.4, probe=(-0.2, 0.1, 1.2), lamp=(0.3, -0.4, 2.1), door_wall=1,
               world_rotation_z=40.0),
+    # A yellow armchair-sized box on a darker floor, 2 m from the probe, for Object from Photo.
+    RoomScene("chair_room", ((-2.5, -2.0), (3.0, -2.0), (3.0, 2.2), (-2.5, 2.2)),
+              ceiling=2.6, probe=(0.0, 0.0, 1.5), lamp=(0.8, 0.5, 2.3), door_wall=2,
+              boxes=((1.8, 0.6, 0.8, 0.7, 0.9, 20.0),)),
 )}
 
 

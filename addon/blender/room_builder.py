@@ -92,6 +92,16 @@ def show_panorama(scene: bpy.types.Scene, path: str) -> None:
     scene.world = world
 
 
+def floor_polygon(scene: bpy.types.Scene) -> np.ndarray | None:
+    """(n, 2) world xy of the Floor's outline where the Floor is one polygon (as Match Room
+    builds it), else None."""
+    floor = scene.objects.get("Floor")
+    if floor is None or floor.type != 'MESH' or len(floor.data.polygons) != 1:
+        return None
+    ring = floor.data.polygons[0].vertices
+    return np.array([tuple((floor.matrix_world @ floor.data.vertices[i].co).xy) for i in ring])
+
+
 def floor_height(scene: bpy.types.Scene) -> float:
     """The z of the Floor object's lowest vertex, 0 where the scene has no Floor mesh."""
     floor = scene.objects.get("Floor")

@@ -115,7 +115,7 @@ def _room(args: argparse.Namespace) -> int:
         if panorama is None:
             raise DimredError(f"--object-at needs the panorama: {missing}")
         box = box_from_click(panorama, tuple(args.object_at), click_size=(clicks.width, clicks.height),
-                             probe=room.probe, rotation=rotation)
+                             probe=room.probe, rotation=rotation, inside=room.corners)
         obj = room_builder.box_object(scene, args.object_name, box.corners())
         if hasattr(scene, "dimred"):
             scene.dimred.mark(obj)

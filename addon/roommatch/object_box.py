@@ -19,11 +19,14 @@ from ..errors import DimredError
 from ..geometry.resample import resample_axis
 from ..segmentation.grabcut import segment_object
 from ..segmentation.masks import dilate
+from .polygon import contains
 from .projection import click_directions, project
 
 _WORKING_WIDTH = 1024
 _WINDOW = 0.12  # half the window's side, as a share of the panorama's width (43 degrees)
 _REFINE_BAND = 0.12  # the second pass's band, as a share of the object's size in pixels
+_SHADING = 0.7  # the share of the luminance divided out of the image the segmentation sees
+_LUMINANCE = np.array([0.2126, 0.7152, 0.0722], dtype=np.float32)
 _PROXY_BAND = 0.3  # the first pass's band around a proxy, as a share of its size in pixels
 _SEED = 1.5  # px radius of the seed disc at the click, on the coarsest copy the segmentation halves to
 _COARSEST_BAND = 16  # the widest band `segment_object` decides without halving
@@ -35,6 +38,8 @@ _DIRECTIONS = np.concatenate([np.diag(_STEPS), _STEPS * np.array([[0, 0, 0, 1, -
                                                                    [0, 0, 1, -1, 0, 0]])])
 _FINEST = 1.0 / 32.0  # the last steps, a share of the first
 _MAX_EVALUATIONS = 600
+_PULL = 0.95  # a first box through a wall moves this much nearer the probe a step, and its depth shrinks
+_PULLS = 40
 
 
 @dataclass(frozen=True)
@@ -51,10 +56,7 @@ class BoxFit:
 
     def corners(self) -> np.ndarray:
         """(8, 3) world corners: the bottom four counter-clockwise, then the top four."""
-        w, d = self.size[:2] / 2.0
-        local = np.array([[-w, -d], [w, -d], [w, d], [-w, d]])
-        c, s = np.cos(self.turn), np.sin(self.turn)
-        xy = local @ np.array([[c, s], [-s, c]]) + self.bottom[:2]
+        xy = _footprint(self.bottom[:2], self.size[:2], self.turn)
         z = np.full((4, 1), self.bottom[2])
         return np.concatenate([np.concatenate([xy, z], axis=1), np.concatenate([xy, z + self.size[2]], axis=1)])
 
@@ -65,8 +67,10 @@ class BoxFit:
 
 
 def box_from_click(panorama: np.ndarray, click: tuple[float, float], *, click_size: tuple[int, int],
-                   probe: np.ndarray, floor_z: float = 0.0, rotation: np.ndarray | None = None) -> BoxFit:
-    """The box proxy of the object clicked at `click` (x, y) on a `click_size` (W, H) panorama;
+                   probe: np.ndarray, floor_z: float = 0.0, rotation: np.ndarray | None = None,
+                   inside: np.ndarray | None = None) -> BoxFit:
+    """The box proxy of the object clicked at `click` (x, y) on a `click_size` (W, H) panorama,
+    its footprint within the floor polygon `inside` ((n, 2) world) where one is given;
     DimredError when the photograph shows no object there standing on the floor."""
     probe, camera = _camera(probe, floor_z)
     view = _View.around(panorama, click, click_size, rotation, _WINDOW)
@@ -80,11 +84,11 @@ def box_from_click(panorama: np.ndarray, click: tuple[float, float], *, click_si
         raise DimredError(f"no object standing on the floor is seen at ({click[0]:g}, {click[1]:g}): click inside "
                           "an object whose foot the panorama shows")
     start = _first_box(points, shown, view.directions, camera)
-    return _fitted(start, shown, view.directions, camera, probe, floor_z)
+    return _fitted(start, _Outline(shown, view.directions, camera, probe, floor_z, inside))
 
 
 def refit_box(panorama: np.ndarray, corners: np.ndarray, *, probe: np.ndarray, floor_z: float = 0.0,
-              rotation: np.ndarray | None = None) -> BoxFit:
+              rotation: np.ndarray | None = None, inside: np.ndarray | None = None) -> BoxFit:
     """A box proxy (`corners` (8, 3) world, standing upright) refitted to the object's outline in
     the photograph: its place, turn and each of its three sizes (Align to Photo keeps the
     proportions). DimredError when the corners are no upright box or the photograph shows
@@ -104,11 +108,11 @@ def refit_box(panorama: np.ndarray, corners: np.ndarray, *, probe: np.ndarray, f
     shown = _segment(view.image, proxy, max(2, int(_PROXY_BAND * extent)))
     # From the proxy as modelled, and from the outline's own first box: a turn off by several
     # degrees can hold the search in a nearby optimum.
-    fits = [_fitted(_front(params), shown, view.directions, camera, probe, floor_z)]
+    outline = _Outline(shown, view.directions, camera, probe, floor_z, inside)
+    fits = [_fitted(_front(params), outline)]
     points = _floor_points(shown, view.directions, camera)
     if len(points) >= 3:
-        fits.append(_fitted(_first_box(points, shown, view.directions, camera), shown, view.directions, camera,
-                            probe, floor_z))
+        fits.append(_fitted(_first_box(points, shown, view.directions, camera), outline))
     return max(fits, key=lambda fit: fit.agreement)
 
 
@@ -150,18 +154,41 @@ def _camera(probe: np.ndarray, floor_z: float) -> tuple[np.ndarray, float]:
     return probe, camera
 
 
-def _fitted(start: np.ndarray, shown: np.ndarray, directions: np.ndarray, camera: float, probe: np.ndarray,
-            floor_z: float) -> BoxFit:
+@dataclass(frozen=True)
+class _Outline:
+    """What a box is fitted to: the outline (h, w) over a window, its pixels' directions from the
+    probe, the probe's height above the floor, the probe, the floor's z, and the floor polygon
+    ((n, 2) world) the box must stand in, if any."""
+
+    shown: np.ndarray
+    directions: np.ndarray
+    camera: float
+    probe: np.ndarray
+    floor_z: float
+    inside: np.ndarray | None
+
+
+def _fitted(start: np.ndarray, outline: _Outline) -> BoxFit:
     # The search looks at the outline's bounding box grown by half its size each way: a box
     # whose silhouette reaches past it agrees less anyway.
+    shown = outline.shown
     rows, cols = np.nonzero(shown)
     pad_r, pad_c = (np.ptp(rows) + 1) // 2, (np.ptp(cols) + 1) // 2
     crop = (slice(max(0, rows.min() - pad_r), rows.max() + pad_r + 1),
             slice(max(0, cols.min() - pad_c), cols.max() + pad_c + 1))
-    params, agreement = _search(start, shown[crop], directions[crop], camera)
-    return BoxFit(bottom=np.array([probe[0] + params[0], probe[1] + params[1], floor_z]),
+    room = None if outline.inside is None else np.asarray(outline.inside, dtype=np.float64) - outline.probe[:2]
+    params, agreement = _search(start, shown[crop], outline.directions[crop], outline.camera, room)
+    probe = outline.probe
+    return BoxFit(bottom=np.array([probe[0] + params[0], probe[1] + params[1], outline.floor_z]),
                   size=np.exp(params[2:5]), turn=float(params[5]), agreement=agreement,
                   outline_pixels=int(shown.sum()))
+
+
+def _footprint(centre: np.ndarray, size: np.ndarray, turn: float) -> np.ndarray:
+    """(4, 2) a box's bottom corners counter-clockwise: centre (2,), width and depth, turn."""
+    w, d = np.asarray(size[:2], dtype=np.float64) / 2.0
+    c, s = np.cos(turn), np.sin(turn)
+    return np.array([[-w, -d], [w, -d], [w, d], [-w, d]]) @ np.array([[c, s], [-s, c]]) + centre
 
 
 def _box_params(corners: np.ndarray, probe: np.ndarray, floor_z: float) -> np.ndarray:
@@ -216,6 +243,9 @@ def _segment(window: np.ndarray, seed: np.ndarray, band: int) -> np.ndarray:
     what was found."""
     if float(np.ptp(window)) <= 1e-6 * max(float(window.max()), 1e-12):
         raise DimredError("the panorama is flat around the click: there is no object to outline")
+    # Shading compressed: a box's lit top and its sides in shade are one material.
+    luminance = np.maximum(window @ _LUMINANCE, 1e-6)[..., None]
+    window = window / luminance ** _SHADING
     part = _holding(segment_object(window, seed, band=band, prior=0.0).object, seed)
     if part.sum() >= _MIN_PIXELS:
         extent = max(np.ptp(np.nonzero(part)[0]), np.ptp(np.nonzero(part)[1]))
@@ -286,13 +316,24 @@ def _centred(front: np.ndarray) -> np.ndarray:
     return np.array([centre[0], centre[1], lw, ld, lh, turn])
 
 
-def _search(params: np.ndarray, shown: np.ndarray, directions: np.ndarray, camera: float) -> tuple[np.ndarray, float]:
-    """Coordinate search on the box's six parameters for the largest intersection over union."""
+def _search(params: np.ndarray, shown: np.ndarray, directions: np.ndarray, camera: float,
+            room: np.ndarray | None) -> tuple[np.ndarray, float]:
+    """Coordinate search on the box's six parameters for the largest intersection over union,
+    its footprint within `room` ((n, 2) from the probe) where given."""
     def score(p: np.ndarray) -> float:
-        box = silhouette(_centred(p), directions, camera)
+        centred = _centred(p)
+        if room is not None and not all(contains(room, corner) for corner in
+                                        _footprint(centred[:2], np.exp(centred[2:4]), centred[5])):
+            return -1.0  # through a wall: never taken
+        box = silhouette(centred, directions, camera)
         return float(np.count_nonzero(box & shown)) / max(float(np.count_nonzero(box | shown)), 1.0)
 
     best = score(params)
+    for _ in range(_PULLS):  # a first box through a wall is drawn towards the probe, then shrunk
+        if best >= 0.0:
+            break
+        params = params * np.array([_PULL, _PULL, 1.0, 1.0, 1.0, 1.0]) - np.array([0, 0, 0, 1 - _PULL, 0, 0])
+        best = score(params)
     scale = 1.0
     evaluations = 1
     while scale > _FINEST and evaluations < _MAX_EVALUATIONS:

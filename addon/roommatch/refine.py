@@ -7,7 +7,7 @@ points found, taken down to the floor, are fitted by a line (weighted by how pre
 places a floor point at that distance, robust to clutter in front of the wall), and each corner
 becomes the crossing of its two walls' lines. Edges where the photograph shows too little keep
 their clicked corners. The result is new clicks, so the fit (and Manhattan snapping) runs on
-them as on the artist's.
+them as on the artist's; a corner the lines would move farther than a click errs keeps its click.
 """
 from __future__ import annotations
 
@@ -18,11 +18,12 @@ import numpy as np
 from .clicks import RoomClicks
 from .fit import RoomFit
 from .photo_edges import edge_samples, log_luminance
-from .projection import click_directions, project
+from .projection import click_directions, pixel_offsets, project
 
 # How far the photograph's edge is looked for, round by round, in pixels of the clicks (a click
 # is good to a pixel or two; farther, a window's frame or a skirting board would be taken).
 _SEARCHES = (3.0, 2.0, 1.5)
+_MAX_MOVE = 2.5  # pixels of the clicks a refined corner may move from its click
 _MIN_SHOWN = 0.3  # share of an edge's samples that must find the photograph's edge
 _MIN_POINTS = 12
 _MIN_ANGLE = np.radians(10.0)  # walls closer to parallel than this do not make a corner
@@ -42,6 +43,11 @@ def refine_clicks(panorama: np.ndarray, clicks: RoomClicks, room: RoomFit, *, ro
         shown = np.array([line is not None for line in lines])
         unit = np.array([_corner(unit[i], lines[i - 1], lines[i]) for i in range(len(unit))])
     floor = project(np.concatenate([unit, -np.ones((len(unit), 1))], axis=1), clicks.width, clicks.height, rotation)
+    clicked = np.asarray(clicks.floor, dtype=np.float64)
+    # A corner the walls' lines put farther from its click than a click errs stays where it was
+    # clicked: a wall seen at a grazing angle places a crossing poorly.
+    far = np.linalg.norm(pixel_offsets(floor, clicked, clicks.width), axis=1) > _MAX_MOVE
+    floor[far] = clicked[far]
     return dataclasses.replace(clicks, floor=tuple(map(tuple, floor.tolist()))), shown
 
 
