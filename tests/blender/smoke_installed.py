@@ -193,6 +193,35 @@ def relocate_run(blend: Path) -> None:
     np.testing.assert_allclose(np.array(box.matrix_world), np.array(photographed), atol=1e-6)
 
 
+def room_run(blend: Path, hdri_path: Path) -> None:
+    """Match Room as a user runs it: floor corners clicked on the tiny room's panorama (its
+    floor's corners projected to pixels and rounded), the room built, its meshes read back."""
+    import bpy
+
+    # The tiny scene without its objects (factory settings would disable the extension).
+    bpy.ops.wm.open_mainfile(filepath=str(blend))
+    for obj in list(bpy.data.objects):
+        bpy.data.objects.remove(obj)
+    room_builder = importlib.import_module(f"{PACKAGE}.addon.blender.room_builder")
+    projection = importlib.import_module(f"{PACKAGE}.addon.roommatch.projection")
+    room_builder.show_panorama(bpy.context.scene, str(hdri_path))
+    (x0, y0, z0), (x1, y1, _) = tiny_scene.ROOM
+    corners = np.array([(x0, y0), (x1, y0), (x1, y1), (x0, y1)])
+    probe = np.asarray(tiny_scene.CENTER, dtype=np.float64)
+    points = np.concatenate([corners - probe[:2], np.full((4, 1), z0 - probe[2])], axis=1)
+    for x, y in np.round(projection.project(points, 64, 32)):
+        assert bpy.ops.dimred.room_click(kind='FLOOR', x=float(x), y=float(y)) == {'FINISHED'}
+    bpy.context.scene.dimred_room.camera_height = float(probe[2] - z0)
+    assert bpy.ops.dimred.match_room() == {'FINISHED'}
+    floor = bpy.data.objects["Floor"].data
+    assert len(floor.vertices) == 4 and len(bpy.data.objects["Walls"].data.polygons) == 4
+    assert "Ceiling" in bpy.data.objects and "Dimred Room Diagnostics" in bpy.data.images
+    found = np.array([tuple(v.co) for v in floor.vertices])
+    # 64 pixels round the panorama: a whole-pixel click is good to a few degrees only.
+    for corner in corners - probe[:2]:
+        assert np.min(np.linalg.norm(found[:, :2] - probe[:2] - corner, axis=1)) < 0.25 * np.linalg.norm(corner)
+
+
 def main(argv: list[str]) -> int:
     work = Path(tempfile.mkdtemp(prefix="dimred-smoke-"))
     # Before bpy is imported: Blender reads its user folders once, at start-up.
@@ -227,6 +256,8 @@ def main(argv: list[str]) -> int:
              work, hdri_path)
         step("bpy.ops.dimred.remove, Cycles render of the world, undo, redo, clear", operator_run, blend, hdri_path)
         step("bpy.ops.dimred.relocate: the box moved and the layer written, clear puts it back", relocate_run, blend)
+        step("bpy.ops.dimred.room_click and match_room: Floor, Walls and Ceiling read back", room_run, blend,
+             hdri_path)
     except Exception:
         pass  # step() printed it; every later step depends on this one
     if failed:
