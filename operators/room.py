@@ -2,7 +2,8 @@
 
 `dimred.room_click` adds clicks: interactively in an Image Editor showing the panorama (left
 click a floor corner, Ctrl+click the wall-ceiling point, Shift+click the known length's ends,
-Enter or right click to match, Esc to stop), or from a script with `kind`, `x` and `y`.
+Alt+click to move the nearest corner, Enter or right click to match, Esc to stop), or from a
+script with `kind`, `x` and `y`.
 `dimred.match_room` fits the room to the clicks (`addon.roommatch`), builds it, sets the probe
 centre and draws the room diagnostics picture. Click files (`dimred room`'s JSON) load and save.
 """
@@ -24,6 +25,7 @@ KIND_ITEMS = (
     ('CEILING', "Ceiling Point", "A point where a wall meets the ceiling"),
     ('LENGTH_START', "Length Start", "The known length's start (on the floor)"),
     ('LENGTH_END', "Length End", "The known length's end"),
+    ('MOVE', "Move Corner", "The nearest floor corner moves here (a matched room re-fits)"),
 )
 
 
@@ -33,6 +35,15 @@ def add_click(scene: bpy.types.Scene, kind: str, x: float, y: float) -> str:
     if kind == 'FLOOR':
         room.corners.add().point = (x, y)
         return f"floor corner {len(room.corners) - 1} at ({x:.1f}, {y:.1f})"
+    if kind == 'MOVE':
+        if not room.corners:
+            raise DimredError("there is no floor corner to move yet")
+        points = np.array([tuple(c.point) for c in room.corners])
+        gap = np.abs(points - (x, y))
+        gap[:, 0] = np.minimum(gap[:, 0], room.width - gap[:, 0])  # the short way round the seam
+        index = int(np.argmin(np.hypot(gap[:, 0], gap[:, 1])))
+        room.corners[index].point = (x, y)
+        return f"floor corner {index} moved to ({x:.1f}, {y:.1f})"
     if kind == 'CEILING':
         room.ceiling, room.use_ceiling = (x, y), True
         return f"ceiling point at ({x:.1f}, {y:.1f})"
@@ -129,8 +140,8 @@ class DIMRED_OT_room_click(PanoramaClick, bpy.types.Operator):
     bl_idname = "dimred.room_click"
     bl_label = "Click Room"
     bl_description = ("Click the floor's corners in order round the room in the Image Editor showing the panorama "
-                      "(Ctrl: the wall-ceiling point, Shift: the known length's ends); Enter or right click matches "
-                      "the room, Esc stops")
+                      "(Ctrl: the wall-ceiling point, Shift: the known length's ends, Alt: move the nearest corner "
+                      "here); Enter or right click matches the room, Esc stops")
     bl_options = {'REGISTER', 'UNDO'}
 
     kind: EnumProperty(name="Kind", items=KIND_ITEMS, default='FLOOR')
@@ -149,7 +160,13 @@ class DIMRED_OT_room_click(PanoramaClick, bpy.types.Operator):
         room.updating = True
         room.width, room.height = size
         room.updating = False
-        self.report({'INFO'}, "Added " + add_click(context.scene, self.kind, self.x, self.y))
+        try:
+            self.report({'INFO'}, add_click(context.scene, self.kind, self.x, self.y).capitalize())
+        except DimredError as error:
+            self.report({'ERROR'}, str(error))
+            return {'CANCELLED'}
+        if room.problem:
+            self.report({'WARNING'}, room.problem)
         return {'FINISHED'}
 
     def invoke(self, context: bpy.types.Context, event: bpy.types.Event) -> set[str]:
@@ -159,7 +176,8 @@ class DIMRED_OT_room_click(PanoramaClick, bpy.types.Operator):
             return {'CANCELLED'}
         context.window_manager.modal_handler_add(self)
         context.workspace.status_text_set("Click Room: click floor corners in order; Ctrl: ceiling point; "
-                                          "Shift: known length's ends; Enter/right click: match; Esc: stop")
+                                          "Shift: known length's ends; Alt: move the nearest corner; "
+                                          "Enter/right click: match; Esc: stop")
         return {'RUNNING_MODAL'}
 
     def modal(self, context: bpy.types.Context, event: bpy.types.Event) -> set[str]:
@@ -174,7 +192,7 @@ class DIMRED_OT_room_click(PanoramaClick, bpy.types.Operator):
             self.take_mouse(context, event)
             room = context.scene.dimred_room
             shift_kind = 'LENGTH_END' if tuple(room.length_start) != (0.0, 0.0) else 'LENGTH_START'
-            self.kind = 'CEILING' if event.ctrl else shift_kind if event.shift else 'FLOOR'
+            self.kind = 'MOVE' if event.alt else 'CEILING' if event.ctrl else shift_kind if event.shift else 'FLOOR'
             self.execute(context)
             context.area.tag_redraw()
             return {'RUNNING_MODAL'}

@@ -72,8 +72,11 @@ def test_moving_a_click_refits_the_room(panorama_room: np.ndarray) -> None:
     scene.dimred_room.corners[0].point = tuple(moved)  # a user dragging corner 0 half a metre along the wall
     floor = _vertices("Floor")
     assert np.min(np.linalg.norm(floor[:, :2] - (-2.5, -1.5), axis=1)) < 0.02
+    back = clicks_of(np.array([[-2.0, -1.5, 0.0]]), PROBE, W, H, rounded=False)[0]
+    assert bpy.ops.dimred.room_click(kind='MOVE', x=float(back[0]), y=float(back[1])) == {'FINISHED'}  # Alt+click
+    assert np.min(np.linalg.norm(_vertices("Floor")[:, :2] - (-2.0, -1.5), axis=1)) < 0.02
     scene.dimred_room.camera_height = 2.0  # and a new height scales the room about the probe at once
-    assert np.min(np.linalg.norm(_vertices("Floor")[:, :2] - (-2.5 * 4 / 3, -2.0), axis=1)) < 0.03
+    assert np.min(np.linalg.norm(_vertices("Floor")[:, :2] - (-2.0 * 4 / 3, -1.5 * 4 / 3), axis=1)) < 0.03
     assert json.loads(scene.dimred_room.summary)["camera_height_m"] == 2.0
 
 
