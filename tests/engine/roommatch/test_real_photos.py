@@ -26,7 +26,8 @@ DATA = Path(__file__).resolve().parents[2] / "data" / "rooms"
 PHOTOS = Path(__file__).resolve().parents[4] / "shared" / "real_photos"
 # The edges (`photo_edges.EdgeOffsets.kinds`) each photograph shows unoccluded.
 CLEAR = {
-    "apartment": ("floor 1", "floor 2", "floor 4", "floor 5", "floor 6", "corner 2", "corner 4"),
+    "apartment": ("floor 1", "floor 2", "floor 4", "floor 5", "floor 6", "ceiling 0", "ceiling 1", "ceiling 4",
+                  "corner 2", "corner 4"),
     "interior": ("ceiling 3",),
 }
 
