@@ -51,7 +51,7 @@ def add_command(commands: argparse._SubParsersAction, *, formatter: type[argpars
                       help="the ceiling's height where the click file has no ceiling point (default 2.5)")
     room.add_argument("--snap", action="store_true",
                       help="first move the floor corners onto the wall-floor edges the panorama shows near them "
-                           "(walls it hides keep their clicks); room.json keeps the clicks as given")
+                           "(walls it hides keep their clicks); room.json keeps the clicks as given under snapped")
     room.add_argument("--object-at", nargs=2, type=float, metavar=("X", "Y"),
                       help="Object from Photo: also fit a box proxy to the object clicked at pixel (X, Y) of the "
                            "click file's panorama, standing on the floor, and mark it for removal")
