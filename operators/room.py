@@ -16,6 +16,7 @@ import numpy as np
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty
 
 from ..addon.errors import DimredError
+from . import room_settings
 from .support import pictures
 
 ROOM_DIAGNOSTICS_IMAGE = "Dimred Room Diagnostics"
@@ -328,6 +329,7 @@ class DIMRED_OT_room_remove_corner(bpy.types.Operator):
             self.report({'ERROR'}, f"there is no floor corner {self.index}")
             return {'CANCELLED'}
         corners.remove(index)
+        room_settings.refit(context.scene)
         return {'FINISHED'}
 
 

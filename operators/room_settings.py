@@ -31,7 +31,11 @@ _KINDS = {'WALL': "wall", 'VERTICAL': "vertical", 'FLOOR': "floor"}
 
 
 def _refit(item: bpy.types.PropertyGroup, context: bpy.types.Context) -> None:
-    scene = item.id_data
+    refit(item.id_data)
+
+
+def refit(scene: bpy.types.Scene) -> None:
+    """Re-fit the scene's room to its clicks if it was matched; a refusal goes to `problem`."""
     room = scene.dimred_room
     if not room.matched or room.updating:
         return

@@ -202,3 +202,14 @@ def test_fit_box_refits_each_size_of_the_marked_box(panorama_room: np.ndarray, t
     bpy.data.objects["Chair"].data.vertices[5].co.x += 0.2  # no longer a box
     with pytest.raises(RuntimeError, match="not an upright box"):
         bpy.ops.dimred.fit_box()
+
+
+def test_removing_a_corner_refits_or_says_why_not(panorama_room: np.ndarray) -> None:
+    scene = bpy.context.scene
+    _click_all(panorama_room)
+    scene.dimred_room.camera_height = 1.5
+    bpy.ops.dimred.match_room()
+    before = _vertices("Floor")
+    bpy.ops.dimred.room_remove_corner(index=0)  # three corners left: a triangle that misses the probe
+    assert "probe centre lies outside" in scene.dimred_room.problem
+    assert np.array_equal(_vertices("Floor"), before)
