@@ -213,3 +213,18 @@ def test_removing_a_corner_refits_or_says_why_not(panorama_room: np.ndarray) -> 
     bpy.ops.dimred.room_remove_corner(index=0)  # three corners left: a triangle that misses the probe
     assert "probe centre lies outside" in scene.dimred_room.problem
     assert np.array_equal(_vertices("Floor"), before)
+
+
+def test_the_panel_draws_the_clicks_the_fit_and_the_picture(panorama_room: np.ndarray) -> None:
+    from diminished_reality.panels import room as room_panel
+    from tests.blender.test_registration import _draw
+
+    _click_all(panorama_room)
+    bpy.context.scene.dimred_room.camera_height = 1.5
+    bpy.ops.dimred.match_room()
+    drawn = _draw(room_panel.DIMRED_PT_room, bpy.context)
+    assert {"operator dimred.room_click", "operator dimred.room_suggest", "operator dimred.match_room",
+            "operator dimred.object_from_photo", "operator dimred.fit_box", "operator dimred.show_room_diagnostics",
+            "prop camera_height", "prop manhattan"} <= set(drawn)
+    assert drawn.count("prop point") == 4
+    assert "label Camera 1.50 m, ceiling 2.50 m (camera height)" in drawn
