@@ -1,0 +1,143 @@
+"""Match Room measured: clicks to the room, Snap to Photo, Suggest Room and Object from Photo on
+the Cycles rooms of known geometry (`scenes.rooms`, rendered once and cached), and the click files
+of the real photographs (tests/data/rooms/):
+    .venv/bin/python benchmarks/bench_room_match.py
+Prints three markdown tables and writes them into docs/results/bench_room_match.md
+(`results.write`). The clicks on a render are its true corners projected to pixels and rounded,
+as a user's clicks are; errors are per metre of the corner's distance from the probe (cm/m) or
+relative (%); edge offsets are pixels at 1024x512.
+"""
+from __future__ import annotations
+
+import dataclasses
+import sys
+import sysconfig
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from addon.geometry.latlong import pixel_directions
+from addon.io.exr import read_exr
+from addon.roommatch import clicks as click_file
+from addon.roommatch.clicks import KnownLength, RoomClicks
+from addon.roommatch.fit import fit_room
+from addon.roommatch.object_box import box_from_click, silhouette
+from addon.roommatch.photo_edges import edge_offsets
+from addon.roommatch.projection import project
+from addon.roommatch.refine import refine_clicks
+from addon.roommatch.suggest import suggest_room
+from results import Table, write
+from scenes.rooms import ROOMS, render_room
+from tests.engine.roommatch.room_truth import clicks_of, distance_errors, floor_points, rotation_z
+
+REPO = Path(__file__).resolve().parents[1]
+PHOTOS = {"apartment": REPO.parent / "shared" / "real_photos" / "apartment.exr",
+          "interior": next(Path(sysconfig.get_paths()["purelib"]).glob(
+              "bpy/*/datafiles/studiolights/world/interior.exr"), Path("interior.exr"))}
+# The hotel armchair's click (tests/data/rooms/interior.json's panorama).
+ARMCHAIR = (478.0, 345.0)
+
+
+def _worst(errors: np.ndarray) -> str:
+    return f"{100 * errors.max():.2f}"
+
+
+def _rooms() -> tuple[Table, Table]:
+    rooms = Table(["room", "corners", "at true height, worst cm/m", "snapped, median / worst cm/m",
+                   "door's height: camera %", "corners worst %", "wall's length: camera %", "corners worst %",
+                   "floor edges px", "suggestion worst cm/m", "fit ms"],
+                  title="Cycles rooms, 1024x512, clicks = true corners rounded to pixels")
+    objects = Table(["room", "box from one click (m)", "turn deg", "agreement with outline", "with true box",
+                     "seconds"], title="Object from Photo on the Cycles room with a box")
+    for room in ROOMS.values():
+        panorama = read_exr(render_room(room))
+        corners, probe = np.asarray(room.corners), np.asarray(room.probe)
+        rotation = rotation_z(room.world_rotation_z)
+        floor = clicks_of(floor_points(corners), probe, room.width, room.height, rotation)
+
+        def fit(clicks: RoomClicks, *, rotation=rotation, room=room):
+            return fit_room(clicks, rotation=rotation, origin=room.probe[:2], ceiling_height=room.ceiling)
+
+        clicks = RoomClicks(room.width, room.height, tuple(map(tuple, floor)), camera_height=room.probe[2])
+        started = time.perf_counter()
+        plain = fit(clicks)
+        ms = 1000 * (time.perf_counter() - started)
+        snapped = fit(refine_clicks(panorama, clicks, plain, rotation=rotation)[0])
+        snap = distance_errors(snapped.corners, corners, probe)
+        ends = clicks_of(room.door()[[0, 3]], probe, room.width, room.height, rotation)
+        door = fit(dataclasses.replace(clicks, camera_height=None, known_length=KnownLength(
+            "vertical", room.door_height, start=tuple(ends[0]), end=tuple(ends[1]))))
+        wall = fit(dataclasses.replace(clicks, camera_height=None, manhattan=True, known_length=KnownLength(
+            "wall", float(np.linalg.norm(corners[1] - corners[0])), edge=0)))
+        edges = edge_offsets(panorama, plain, rotation=rotation).offsets[:len(corners)]
+        found = suggest_room(panorama, width=room.width, height=room.height, rotation=rotation)
+        if found.clicks is None:
+            suggestion = "none"
+        else:
+            proposed = fit(dataclasses.replace(found.clicks, camera_height=room.probe[2])).corners
+            nearest = np.array([proposed[np.argmin(np.linalg.norm(proposed - c, axis=1))] for c in corners])
+            suggestion = f"{_worst(distance_errors(nearest, corners, probe))} ({len(proposed)} corners)"
+        rooms.row(room.name, len(corners), _worst(distance_errors(plain.corners, corners, probe)),
+                  f"{100 * np.median(snap):.2f} / {100 * snap.max():.2f}",
+                  f"{100 * (door.camera_height / probe[2] - 1):+.2f}",
+                  _worst(distance_errors(door.corners, corners, probe)),
+                  f"{100 * (wall.camera_height / probe[2] - 1):+.2f}",
+                  _worst(distance_errors(wall.corners, corners, probe)),
+                  f"{np.nanmin(edges):.2f}-{np.nanmax(edges):.2f}", suggestion, f"{ms:.1f}")
+        for x, y, width, depth, tall, turn in room.boxes:
+            click = project(np.array([x, y, tall / 2]) - probe, room.width, room.height, rotation)
+            started = time.perf_counter()
+            box = box_from_click(panorama, tuple(np.round(click)), click_size=(room.width, room.height), probe=probe,
+                                 rotation=rotation, inside=corners)
+            seconds = time.perf_counter() - started
+            rays = pixel_directions(room.width, room.height, rotation)
+            fitted = np.array([*(box.bottom[:2] - probe[:2]), *np.log(box.size), box.turn])
+            truth = np.array([x - probe[0], y - probe[1], np.log(width), np.log(depth), np.log(tall),
+                              np.radians(turn)])
+            seen, true = silhouette(fitted, rays, probe[2]), silhouette(truth, rays, probe[2])
+            objects.row(room.name, " x ".join(f"{v:.2f}" for v in box.size) + f" (true {width} x {depth} x {tall})",
+                        f"{np.degrees(box.turn):.1f} (true {turn})", f"{box.agreement:.3f}",
+                        f"{np.count_nonzero(seen & true) / np.count_nonzero(seen | true):.3f}", f"{seconds:.2f}")
+    return rooms, objects
+
+
+def _photos() -> Table:
+    table = Table(["photograph", "clicks", "floor edges px (shown >= 90 %)", "ceiling edges px (shown >= 90 %)",
+                   "object from one click", "suggestion"], title="Real photographs, edges at 1024x512")
+    for name, path in PHOTOS.items():
+        if not path.is_file():
+            table.row(name, "-", "photograph not on this machine", "", "", "")
+            continue
+        clicks = click_file.from_json((REPO / "tests" / "data" / "rooms" / f"{name}.json").read_text())
+        panorama = read_exr(path)
+        room = fit_room(clicks)
+        found = edge_offsets(panorama, room)
+        n = len(clicks.floor)
+
+        def listed(offsets: np.ndarray, shown: np.ndarray) -> str:
+            return ", ".join(f"{v:.1f}" for v, s in zip(offsets, shown, strict=True) if s >= 0.9 and np.isfinite(v))
+
+        count = n + (clicks.ceiling is not None)
+        obj = "-"
+        if name == "interior":
+            box = box_from_click(panorama, ARMCHAIR, click_size=(clicks.width, clicks.height), probe=room.probe,
+                                 inside=room.corners)
+            obj = " x ".join(f"{v:.2f}" for v in box.size) + f" m, agreement {box.agreement:.3f}"
+            count += 1
+        suggestion = suggest_room(panorama, width=panorama.shape[1], height=panorama.shape[0])
+        table.row(name, f"{count} + height", listed(found.offsets[:n], found.shown[:n]) or "none",
+                  listed(found.offsets[n:2 * n], found.shown[n:2 * n]) or "none", obj,
+                  "none" if suggestion.clicks is None else f"{len(suggestion.clicks.floor)} corners")
+    return table
+
+
+def main() -> None:
+    rooms, objects = _rooms()
+    write(rooms, objects, _photos())
+
+
+if __name__ == "__main__":
+    main()
