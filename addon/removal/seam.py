@@ -29,6 +29,7 @@ _SIGNIFICANCE = 1.0
 # A texture's steps are rare but large (most pairs of strips lie within one tile): a high
 # quantile of them, not their median, is what a boundary may show by chance.
 _STEP_QUANTILE = 0.9
+_ALIKE = 4.0  # within this factor of the boundary's median luminance: the surface's material
 _AROUND = 2  # reaches: the surface around the hole whose own steps are measured
 def seamless_change(radiance: np.ndarray, change: np.ndarray, filled: np.ndarray, surface: np.ndarray
                     ) -> np.ndarray:
@@ -54,7 +55,11 @@ def seamless_change(radiance: np.ndarray, change: np.ndarray, filled: np.ndarray
         boundary = inside & dilate(outside, 1) & (n_out > 0) & (n_in > 0)
         if not boundary.any():
             continue
-        spread = _step_spread(edited, outside & dilate(inside, _AROUND * reach), reach, band)
+        # The surface's own steps are those of its material: not a desk or a rug's stripes beside it.
+        luma = edited @ LUMA
+        typical = float(np.median(luma[outer]))
+        alike = (luma > typical / _ALIKE) & (luma < typical * _ALIKE)
+        spread = _step_spread(edited, outside & alike & dilate(inside, _AROUND * reach), reach, band)
         step, _ = box_mean(np.where(boundary[..., None], m_out - m_in, 0.0), boundary, _ALONG * reach)
         kept = np.clip(1 - (_SIGNIFICANCE * spread / np.maximum(np.abs(step @ LUMA), 1e-30)) ** 2, 0.0, 1.0)
         membrane = _pull_push(np.where(boundary[..., None], step * kept[..., None], 0.0), boundary)
