@@ -40,13 +40,13 @@ def open_scene(args: argparse.Namespace) -> tuple[scene_specs.SceneSpec, dict[st
 FLOOR_SCENES = "basic_box,wall_contact,far_dark_box,tile_stool,stool,warm_cylinder,demo,oak_chair,walnut_crate,far_pouf"
 
 
-def scene_list_arguments(description: str, scenes: str) -> argparse.Namespace:
+def scene_list_arguments(description: str, scenes: str, *, width: int = 1024, samples: int = 16) -> argparse.Namespace:
     """Parsed --scenes (comma-separated, default `scenes`), --width (height = width / 2) and
     --samples (the demo gets at least 32)."""
     ap = argparse.ArgumentParser(description=description, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--scenes", default=scenes)
-    ap.add_argument("--width", type=int, default=1024)
-    ap.add_argument("--samples", type=int, default=16, help="Cycles samples (the demo gets at least 32)")
+    ap.add_argument("--width", type=int, default=width)
+    ap.add_argument("--samples", type=int, default=samples, help="Cycles samples (the demo gets at least 32)")
     return ap.parse_args()
 
 

@@ -313,3 +313,26 @@ def bruise_share(edit: np.ndarray, truth: np.ndarray, object_mask: np.ndarray, *
     surface = _blurred_y(truth)[dilate(mask, width_px)]
     darkest = factor * float(np.percentile(surface, percentile))
     return float((_blurred_y(edit)[mask] < darkest).mean())
+
+
+def clean_removal_scores(input: np.ndarray, edit: np.ndarray, truth: np.ndarray,
+                         object_mask: np.ndarray) -> dict[str, float]:
+    """The figures a removal on a photo-textured room is held to:
+
+    - `light`: `lighting_error_ratio` (NaN when the removal changed no lighting beyond noise);
+    - `structure`, `detail`, `total`: `hidden_region_scores`' structure, detail ratio and
+      object + shadow error ratio;
+    - `mean_error`: |mean Y_edit / mean Y_truth - 1| over the object's pixels;
+    - `far_damage`: `far_damage`;
+    - `bruise_share`: `bruise_share`."""
+    region = lighting_region(input, truth, object_mask)
+    hidden = hidden_region_scores(input, edit, truth, object_mask)
+    return {
+        "light": lighting_error_ratio(input, edit, truth, object_mask, region) if region.any() else float("nan"),
+        "structure": hidden["structure"],
+        "detail": hidden["detail_ratio"],
+        "mean_error": abs(hidden["mean_ratio"] - 1.0),
+        "total": hidden["object_shadow_ratio"],
+        "far_damage": far_damage(input, edit, truth, object_mask, region),
+        "bruise_share": bruise_share(edit, truth, object_mask),
+    }

@@ -729,7 +729,7 @@ def _hotel_box() -> SceneSpec:
         name="hotel_box",
         room=room,
         lamps=(Lamp((-0.5, 1.5), (0.3, 0.3), 30.0, (1.0, 0.9, 0.75)),),
-        objects=(SceneObject("Box", "box", (0.5, 0.5, 0.5), _on_floor(room, 0.65, 0.7), (0.5, 0.48, 0.45),
+        objects=(SceneObject("Box", "box", (0.5, 0.5, 0.5), _on_floor(room, -0.7, 0.8), (0.5, 0.48, 0.45),
                              rotation_z=10.0),),
         probe=(0.0, -0.4, 1.5),
         remove="Box",
@@ -764,7 +764,7 @@ def _apartment_chair() -> SceneSpec:
         name="apartment_chair",
         room=room,
         lamps=(Lamp((0.6, 1.2), (0.5, 0.5), 25.0),),
-        objects=(SceneObject("Chair", "chair", (0.45, 0.45, 0.9), _on_floor(room, 1.1, 1.0), (0.6, 0.45, 0.3),
+        objects=(SceneObject("Chair", "chair", (0.45, 0.45, 0.9), _on_floor(room, 0.8, 0.6), (0.6, 0.45, 0.3),
                              rotation_z=30.0, seat_height=0.46),),
         probe=(0.0, 0.0, 1.6),
         remove="Chair",
@@ -782,7 +782,7 @@ def _lobby_stool() -> SceneSpec:
         room=room,
         lamps=(Lamp((-1.5, 0.0), (0.2, 0.2), 120.0), Lamp((0.0, 0.0), (0.2, 0.2), 120.0),
                Lamp((1.5, 0.0), (0.2, 0.2), 120.0)),
-        objects=(SceneObject("Stool", "stool", (0.38, 0.38, 0.6), _on_floor(room, -0.6, -1.3), (0.25, 0.25, 0.28),
+        objects=(SceneObject("Stool", "stool", (0.38, 0.38, 0.6), _on_floor(room, -0.5, -0.7), (0.25, 0.25, 0.28),
                              rotation_z=15.0, seat="round", legs=4),),
         probe=(0.2, 0.3, 1.6),
         remove="Stool",
@@ -792,14 +792,15 @@ def _lobby_stool() -> SceneSpec:
 
 
 def _warehouse_box() -> SceneSpec:
-    # Plain concrete under strip lights, a crate, daylight from the north.
+    # Plain concrete under strip lights, an orange crate (its colour bleeds onto the grey), daylight
+    # from the north.
     room = Room(lo=(-2.5, -2.5, 0.0), hi=(2.5, 2.5, 3.0), wall_albedo=(0.7, 0.7, 0.7),
                 floor=_photo_floor("warehouse.exr"))
     return SceneSpec(
         name="warehouse_box",
         room=room,
         lamps=(Lamp((-1.0, 0.0), (1.4, 0.15), 40.0), Lamp((1.2, 0.0), (1.4, 0.15), 40.0)),
-        objects=(SceneObject("Crate", "box", (0.6, 0.45, 0.5), _on_floor(room, 1.3, -1.1), (0.55, 0.45, 0.32),
+        objects=(SceneObject("Crate", "box", (0.6, 0.45, 0.5), _on_floor(room, 1.0, -0.8), (0.6, 0.3, 0.12),
                              rotation_z=25.0),),
         probe=(0.0, 0.2, 1.6),
         remove="Crate",

@@ -1,0 +1,88 @@
+"""Removal on the photo-textured ground-truth rooms (floors projected from real photographs,
+windows, lamps; `scenes.spec.PHOTO_SPECS`), through the engine as the command line runs it
+(balanced, exact proxies):
+    .venv/bin/python benchmarks/bench_photo_groundtruth.py [--scenes a,b] [--width 512] [--samples 32]
+Prints a markdown table of `scenes.metrics.clean_removal_scores`: light error, fill structure,
+detail, fill mean error, total (object + shadow error left), far damage, bruise share (hidden
+pixels darker than 0.8 x the clean surface's 1st percentile), then the surfaces filled and the
+source of their exemplars where the report names it (`filled_surfaces`), and the seconds.
+The table goes to docs/results/bench_photo_groundtruth.md. out/photo_gt/<scene>.png shows the
+panorama with the object, the truth without it and ours side by side, each above a crop around
+the object three times enlarged, at the truth's exposure.
+Renders are cached (scenes.render); the first run renders what is missing (a minute or two each).
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from rendered import ground_truths, scene_list_arguments
+from results import Table, write
+
+OUT = Path(__file__).resolve().parents[1] / "out" / "photo_gt"
+BOUNDS = "Bounds (issue 33): total <= 0.2, mean error <= 0.05, detail 0.8-1.2, bruise share <= 0.02, far damage <= 0.05"
+
+
+def comparison(images: list[np.ndarray], mask: np.ndarray, *, zoom: int = 3) -> np.ndarray:
+    """(H', W', 3) uint8: the panoramas side by side, each above its crop around `mask` (padded
+    by half its size, `zoom` times enlarged), tonemapped at the exposure of the last one."""
+    from scenes.images import auto_exposure, tonemap
+
+    exposure = auto_exposure(images[-1])
+    rows, cols = np.nonzero(mask)
+    pad_r, pad_c = max(8, np.ptp(rows) // 2), max(8, np.ptp(cols) // 2)
+    r0, r1 = max(0, rows.min() - pad_r), min(mask.shape[0], rows.max() + pad_r + 1)
+    c0, c1 = max(0, cols.min() - pad_c), min(mask.shape[1], cols.max() + pad_c + 1)
+    panels = []
+    for image in images:
+        full = tonemap(image, exposure)
+        crop = tonemap(image[r0:r1, c0:c1], exposure).repeat(zoom, axis=0).repeat(zoom, axis=1)
+        width = max(full.shape[1], crop.shape[1])
+        panel = np.full((full.shape[0] + crop.shape[0] + 4, width + 4, 3), 255, np.uint8)
+        panel[:full.shape[0], :full.shape[1]] = full
+        panel[full.shape[0] + 4:, :crop.shape[1]] = crop
+        panels.append(panel)
+    return np.concatenate(panels, axis=1)
+
+
+def _sources(report: dict) -> str:
+    """The filled surfaces, each with its exemplars' source and their share of the surface where
+    the report has them ('exemplar', 'exemplar_share'), else whether it was synthesised."""
+    def source(f: dict) -> str:
+        if f.get("exemplar") is None:
+            return "synthesised" if f["synthesised"] else "mean"
+        share = f.get("exemplar_share")
+        return f["exemplar"] if share is None else f"{f['exemplar']} {share:.0%}"
+
+    return ", ".join(f"{f['surface']}: {source(f)}" for f in report.get("filled_surfaces", [])) or "-"
+
+
+def main() -> None:
+    from scenes.spec import PHOTO_SPECS
+
+    args = scene_list_arguments(__doc__, ",".join(PHOTO_SPECS), width=512, samples=32)
+
+    from addon.pipeline import remove_object
+    from scenes import metrics
+    from scenes.images import write_png
+
+    OUT.mkdir(parents=True, exist_ok=True)
+    table = Table(["scene", "photo", "object", "light", "structure", "detail", "mean error", "total", "far damage",
+                   "bruise share", "filled (source)", "seconds"],
+                  title=f"{args.width}x{args.width // 2} at {args.samples} samples, balanced, exact proxies")
+    for gt in ground_truths(args):
+        s = gt.spec
+        r = remove_object(gt.scene, s.remove, quality="balanced")
+        edit = gt.input + r.difference
+        f = metrics.clean_removal_scores(gt.input, edit, gt.truth, gt.mask)
+        write_png(OUT / f"{s.name}.png", comparison([gt.input, gt.truth, edit], gt.mask))
+        table.row(s.name, s.room.floor.photo.source, s.removed_object().kind, f"{f['light']:.3f}",
+                  f"{f['structure']:.3f}", f"{f['detail']:.2f}", f"{f['mean_error']:.3f}", f"{f['total']:.3f}",
+                  f"{f['far_damage']:.3f}", f"{f['bruise_share']:.3f}", _sources(r.report),
+                  f"{r.report['seconds']['total']:.1f}")
+    write(table, notes=[BOUNDS])
+
+
+if __name__ == "__main__":
+    main()
