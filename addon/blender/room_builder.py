@@ -34,8 +34,8 @@ def match_room(scene: bpy.types.Scene, clicks: RoomClicks, *,
     """Fit the room the clicks show and build it in `scene`; DimredError and nothing changed when
     the clicks show none or an object in the way is not a mesh."""
     rotation = panorama_rotation(scene)
-    origin = tuple(scene.objects[reader.PROBE_OBJECT_NAME].location[:2]) \
-        if reader.PROBE_OBJECT_NAME in scene.objects else (0.0, 0.0)
+    # The room is built round the probe centre where the scene has one: only its height changes.
+    origin = tuple(reader.probe_center(scene)[:2])
     room = fit_room(clicks, rotation=rotation, origin=origin, ceiling_height=ceiling_height)
     for name in NAMES:
         obj = bpy.data.objects.get(name)

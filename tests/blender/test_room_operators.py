@@ -228,3 +228,14 @@ def test_the_panel_draws_the_clicks_the_fit_and_the_picture(panorama_room: np.nd
             "prop camera_height", "prop manhattan"} <= set(drawn)
     assert drawn.count("prop point") == 4
     assert "label Camera 1.50 m, ceiling 2.50 m (camera height)" in drawn
+
+
+def test_the_room_is_built_round_the_probe_centre_set(panorama_room: np.ndarray) -> None:
+    scene = bpy.context.scene
+    scene.dimred.probe_center, scene.dimred.use_probe_center = (1.0, -2.0, 5.0), True
+    _click_all(panorama_room)
+    scene.dimred_room.camera_height = 1.5
+    bpy.ops.dimred.match_room()
+    assert tuple(scene.dimred.probe_center) == pytest.approx((1.0, -2.0, 1.5))
+    floor = _vertices("Floor")[:, :2]
+    assert max(np.min(np.linalg.norm(floor - (c + (1.0, -2.0)), axis=1)) for c in BOX) < 0.1
