@@ -36,8 +36,8 @@ FAR_DAMAGE = 0.08
 DETAIL_PIXELS = 100
 
 
-def _remove(name: str, tmp_path, quality: str = "balanced"):
-    spec = S.get(name)
+def _remove(name: str | S.SceneSpec, tmp_path, quality: str = "balanced"):
+    spec = S.get(name) if isinstance(name, str) else name
     paths = render_pair(spec)
     out = tmp_path / "out"
     proc = subprocess.run(

@@ -1,0 +1,73 @@
+"""Removal on photo-textured rooms, checked against physics: floors projected from real
+photographs (their grain, a rug, furniture feet and contact shadows printed on them), lit by a
+window and ceiling lamps, rendered with and without the object (`scenes.spec.PHOTO_SPECS`).
+
+Each scene goes through the command line as a user runs it (balanced) once, and each figure of
+`scenes.metrics.clean_removal_scores` is held to the issue's bound in a test of its own. Where the
+engine does not meet a bound yet, that test is marked xfail (strict) with the measured figure: it
+turns into a failure the day the engine passes, and the mark is then taken off.
+Renders are 256x128 at 32 samples (a few seconds each on two cores), cached.
+"""
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import pytest
+from test_removal_groundtruth import _remove
+
+from scenes import metrics as M
+from scenes import spec as S
+
+SCENES = ["hotel_box", "apartment_chair", "workshop_box"]
+SIZE = {"width": 256, "height": 128, "samples": 32}
+# figure: (lowest, highest) it may take.
+BOUNDS = {
+    "total": (None, 0.2),
+    "mean_error": (None, 0.05),
+    "detail": (0.8, 1.2),
+    "bruise_share": (None, 0.02),
+    "far_damage": (None, 0.05),
+}
+# (scene, figure): what the engine measured where it fails the bound (at 8112453 with the
+# material-matched exemplars of bb19b41, 256x128).
+FAILING: dict[tuple[str, str], str] = {
+    # The fill of the wood between the rug and the desk chair is a quarter darker than the wood
+    # and half as detailed.
+    ("hotel_box", "total"): "measured 0.537",
+    ("hotel_box", "mean_error"): "measured 0.269",
+    ("hotel_box", "detail"): "measured 0.50",
+    ("apartment_chair", "mean_error"): "measured 0.055",
+    # The yellow floor line is continued into the hole with a branch the truth does not have.
+    ("workshop_box", "total"): "measured 0.511",
+}
+
+
+@pytest.fixture(scope="module")
+def scores(tmp_path_factory: pytest.TempPathFactory) -> Callable[[str], dict[str, float]]:
+    """scores(name): the figures of a scene, removed once per module run."""
+    measured: dict[str, dict[str, float]] = {}
+
+    def of(name: str) -> dict[str, float]:
+        if name not in measured:
+            spec = S.get(name).with_render(**SIZE)
+            inp, edit, truth, mask, _, _ = _remove(spec, tmp_path_factory.mktemp(name))
+            measured[name] = M.clean_removal_scores(inp, edit, truth, mask)
+            print(f"{name}: {measured[name]}")
+        return measured[name]
+
+    return of
+
+
+def _case(name: str, figure: str) -> pytest.param:
+    reason = FAILING.get((name, figure))
+    marks = [pytest.mark.xfail(strict=True, reason=reason)] if reason else []
+    return pytest.param(name, figure, marks=marks, id=f"{name}-{figure}")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("name", "figure"), [_case(n, f) for n in SCENES for f in BOUNDS])
+def test_photo_textured_removal_within_bounds(name: str, figure: str, scores) -> None:
+    value = scores(name)[figure]
+    low, high = BOUNDS[figure]
+    assert (low is None or value >= low) and (high is None or value <= high), \
+        f"{name}: {figure} {value:.3f} outside [{low}, {high}]"
