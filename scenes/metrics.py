@@ -297,20 +297,20 @@ def ring_error(input: np.ndarray, edited: np.ndarray, truth: np.ndarray, silhoue
     return float(local_error(edited).sum() / local_error(input).sum())
 
 
-def bruise_share(edit: np.ndarray, truth: np.ndarray, object_mask: np.ndarray, *, width_px: int | None = None,
+def bruise_share(edit: np.ndarray, truth: np.ndarray, object_mask: np.ndarray, *, width_px: int = 0,
                  factor: float = 0.8, percentile: float = 1.0) -> float:
     """Share of the object's pixels (the hidden region) that the edit fills darker than anything
     the clean surface there shows: blurred Y_edit below `factor` times the `percentile` of the
-    truth's blurred Y over the object's pixels and `width_px` px around them (default W/64, at
-    least 4). A fill that copies a chair's dark legs, a rug's black stripes or the object's own
-    contact shadow into a light floor leaves such a bruise; render noise does not (the blur, and
-    the percentile of the truth's own noisy pixels). Raises ValueError if the mask is empty."""
+    truth's blurred Y over the object's pixels (and `width_px` px around them). A fill that
+    copies a chair's dark legs, a rug's black stripes or the object's own contact shadow into a
+    light floor leaves such a bruise; render noise does not (the blur, and the percentile of the
+    truth's own noisy pixels). The truth under the object is the clean surface: a ring around
+    it takes in the clutter beside the object, the very source of the bruises it is to catch.
+    Raises ValueError if the mask is empty."""
     mask = np.asarray(object_mask, dtype=bool)
     if not mask.any():
         raise ValueError("the object mask is empty")
-    if width_px is None:
-        width_px = max(4, mask.shape[1] // 64)
-    surface = _blurred_y(truth)[dilate(mask, width_px)]
+    surface = _blurred_y(truth)[dilate(mask, width_px) if width_px else mask]
     darkest = factor * float(np.percentile(surface, percentile))
     return float((_blurred_y(edit)[mask] < darkest).mean())
 

@@ -207,9 +207,14 @@ def test_bruise_share_counts_fill_pixels_darker_than_the_clean_surface() -> None
     assert M.bruise_share(edit, truth, mask) == pytest.approx((24 + 2 * 10) / 96)
     # 15 % darker everywhere is a mismatch of brightness, not a bruise.
     assert M.bruise_share(truth * 0.85, truth, mask) == 0.0
-    # The same stripe is no bruise where the clean surface shows as dark a stripe nearby.
+    # The same stripe is no bruise where the clean surface under the object shows a stripe as
+    # dark, or, when asked to look that far, one nearby.
     striped = truth.copy()
-    striped[4:6, 2:30] = 0.05
+    striped[14:16, 8:20] = 0.05
     assert M.bruise_share(edit, striped, mask) == 0.0
+    nearby = truth.copy()
+    nearby[4:6, 2:30] = 0.05
+    assert M.bruise_share(edit, nearby, mask) > 0.4
+    assert M.bruise_share(edit, nearby, mask, width_px=4) == 0.0
     with pytest.raises(ValueError, match="empty"):
         M.bruise_share(truth, truth, np.zeros((H, W), bool))
