@@ -2,7 +2,9 @@
 
 A `SceneSpec` is everything that decides the pixels of a ground-truth render: a closed
 Lambertian room, rectangular ceiling lamps, objects, the probe centre, the object to remove,
-the world's Mapping-node rotation and the Cycles settings. `key()` names its render cache.
+the world's Mapping-node rotation and the Cycles settings; the photo-textured rooms
+(`PHOTO_SPECS`) add a floor projected from a real photograph, windows and chairs, which
+`scenes.build_extended` builds. `key()` names its render cache.
 
 The named specs differ on purpose (room shape and placement, floor texture, lamp count, size
 and power, object kind, colour and position in the panorama) so that the engine is not tuned
