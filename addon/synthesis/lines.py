@@ -6,7 +6,7 @@ slowly there. A copy of another stretch, however well its seams line up, brings 
 grain and shade. Measured on the floors of Cycles renders without the object (the truth itself,
 so no lighting estimate in the way), copying each hidden pixel from the nearest floor seen along
 its plank scored 0.47-0.67 in structure at 1024x512, interpolating between the two nearest
-0.54-0.72 (README, "Structure first").
+0.54-0.72.
 """
 from __future__ import annotations
 

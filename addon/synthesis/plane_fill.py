@@ -284,7 +284,7 @@ def _with_photograph_detail(rho: np.ndarray, panorama: PanoramaReflectance, plan
     lookup keeps a single pixel's grain (`planeraster.sample_points_keeping_grain`): a plain
     bilinear lookup kept 0.64-0.81 of the truth's pixel detail at 1024x512 on composed floors,
     this one 0.87-1.03, for 0.00-0.02 of structure (the copy's grain is its own, not the
-    truth's). Sharper lookups that move or blur the copy did worse (README, "Structure first")."""
+    truth's). Sharper lookups that move or blur the copy did worse."""
     maps = panorama.maps
     r, c = _nearest_cells(raster, plane.points)
     sel = np.flatnonzero(field.copied[r, c])
