@@ -238,4 +238,4 @@ def test_the_room_is_built_round_the_probe_centre_set(panorama_room: np.ndarray)
     bpy.ops.dimred.match_room()
     assert tuple(scene.dimred.probe_center) == pytest.approx((1.0, -2.0, 1.5))
     floor = _vertices("Floor")[:, :2]
-    assert max(np.min(np.linalg.norm(floor - (c + (1.0, -2.0)), axis=1)) for c in BOX) < 0.1
+    assert max(np.min(np.linalg.norm(floor - c - np.array([1.0, -2.0]), axis=1)) for c in BOX) < 0.1
