@@ -23,7 +23,7 @@ import bpy
 
 from . import build as base
 from . import render_job
-from .photo_texture import baked_floor
+from .photo_texture import baked_floor, baked_walls, wall_axis
 from .spec import Room, SceneObject, SceneSpec, Window
 
 if TYPE_CHECKING:
@@ -43,6 +43,11 @@ def build(spec: SceneSpec, include_removed: bool = True) -> None:
         floor = bpy.data.objects["Floor"]
         floor.data.materials.clear()
         floor.data.materials.append(_photo_floor_material(spec.room))
+    if spec.room.wall_photo is not None:
+        for wall, path in baked_walls(spec.room, spec.room.wall_photo).items():
+            mesh = bpy.data.objects[f"Wall.{wall.capitalize()}"].data
+            mesh.materials.clear()
+            mesh.materials.append(_photo_wall_material(spec.room, wall, path))
     for wall in {w.wall for w in spec.windows}:
         _wall_with_windows(scene, spec.room, wall, [w for w in spec.windows if w.wall == wall])
     for obj in spec.objects:
@@ -55,29 +60,56 @@ def build(spec: SceneSpec, include_removed: bool = True) -> None:
 def _photo_floor_material(room: Room) -> bpy.types.Material:
     """Diffuse BSDF whose albedo is the baked photograph, mapped by world x, y onto the floor's
     rectangle (packed into the .blend, which then stands alone)."""
-    mat, nt = base._new_material("Floor")
+    mat, nt = _textured("Floor", baked_floor(room, room.floor.photo))
+    position = nt.nodes.new("ShaderNodeNewGeometry").outputs["Position"]
+    _map_rectangle(nt, position, (room.lo[0], room.lo[1]), (room.hi[0], room.hi[1]))
+    return mat
+
+
+def _photo_wall_material(room: Room, wall: str, path: Path) -> bpy.types.Material:
+    """As the floor's: the wall's texture mapped by (its axis, z) onto its rectangle."""
+    mat, nt = _textured(f"Wall.{wall.capitalize()}", path)
+    axis = wall_axis(wall)
+    xyz = nt.nodes.new("ShaderNodeSeparateXYZ")
+    nt.links.new(nt.nodes.new("ShaderNodeNewGeometry").outputs["Position"], xyz.inputs["Vector"])
+    az = nt.nodes.new("ShaderNodeCombineXYZ")
+    nt.links.new(xyz.outputs["XY"[axis]], az.inputs["X"])
+    nt.links.new(xyz.outputs["Z"], az.inputs["Y"])
+    _map_rectangle(nt, az.outputs["Vector"], (room.lo[axis], room.lo[2]), (room.hi[axis], room.hi[2]))
+    return mat
+
+
+def _textured(name: str, path: Path) -> tuple[bpy.types.Material, bpy.types.NodeTree]:
+    """A Diffuse BSDF whose colour is an Image Texture node of `path` (packed, linear); the
+    texture's vector is linked by `_map_rectangle`."""
+    mat, nt = base._new_material(name)
     bsdf = nt.nodes.new("ShaderNodeBsdfDiffuse")
     bsdf.inputs["Roughness"].default_value = 0.0
     out = nt.nodes.new("ShaderNodeOutputMaterial")
     nt.links.new(bsdf.outputs["BSDF"], out.inputs["Surface"])
-    image = bpy.data.images.load(str(baked_floor(room, room.floor.photo)), check_existing=False)
+    image = bpy.data.images.load(str(path), check_existing=False)
     image.colorspace_settings.name = "Linear Rec.709"
     image.pack()
     tex = nt.nodes.new("ShaderNodeTexImage")
     tex.image = image
     tex.interpolation = "Linear"
     tex.extension = "EXTEND"
-    (x0, y0, _), (x1, y1, _) = room.lo, room.hi
+    nt.links.new(tex.outputs["Color"], bsdf.inputs["Color"])
+    return mat, nt
+
+
+def _map_rectangle(nt: bpy.types.NodeTree, vector: bpy.types.NodeSocket, lo: tuple[float, float],
+                   hi: tuple[float, float]) -> None:
+    """Feed `vector`'s (x, y), mapped from the rectangle lo..hi onto 0..1, to the image texture."""
     mapping = nt.nodes.new("ShaderNodeMapping")
     mapping.vector_type = "POINT"
     # (p - lo) / (hi - lo): the Mapping node scales after it translates, so translate by
-    # -lo / (hi - lo) in scaled units.
-    mapping.inputs["Scale"].default_value = (1 / (x1 - x0), 1 / (y1 - y0), 0.0)
-    mapping.inputs["Location"].default_value = (-x0 / (x1 - x0), -y0 / (y1 - y0), 0.5)
-    nt.links.new(nt.nodes.new("ShaderNodeNewGeometry").outputs["Position"], mapping.inputs["Vector"])
+    # -lo / (hi - lo) in scaled units. z is pinned to 0.5, away from any texel boundary.
+    mapping.inputs["Scale"].default_value = (1 / (hi[0] - lo[0]), 1 / (hi[1] - lo[1]), 0.0)
+    mapping.inputs["Location"].default_value = (-lo[0] / (hi[0] - lo[0]), -lo[1] / (hi[1] - lo[1]), 0.5)
+    nt.links.new(vector, mapping.inputs["Vector"])
+    tex = next(n for n in nt.nodes if n.bl_idname == "ShaderNodeTexImage")
     nt.links.new(mapping.outputs["Vector"], tex.inputs["Vector"])
-    nt.links.new(tex.outputs["Color"], bsdf.inputs["Color"])
-    return mat
 
 
 # --- windows --------------------------------------------------------------------------------

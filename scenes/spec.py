@@ -84,6 +84,7 @@ class Room:
     wall_albedo: Vec3 = (0.7, 0.7, 0.68)
     ceiling_albedo: Vec3 = (0.8, 0.8, 0.8)
     floor: Floor = field(default_factory=Floor)
+    wall_photo: Photo | None = field(default=None, metadata=_ADDED)  # walls from a photograph
 
 
 @dataclass(frozen=True)
@@ -177,7 +178,7 @@ class SceneSpec:
     def extended(self) -> bool:
         """Whether the scene uses what `scenes.build_extended` builds: a floor from a
         photograph, windows or chairs."""
-        return (self.room.floor.photo is not None or bool(self.windows)
+        return (self.room.floor.photo is not None or self.room.wall_photo is not None or bool(self.windows)
                 or any(o.kind == "chair" for o in self.objects))
 
     def to_dict(self) -> dict[str, Any]:
@@ -189,6 +190,8 @@ class SceneSpec:
         if floor.get("photo") is not None:
             floor["photo"] = Photo(**_tuples(floor["photo"]))
         room = dict(d["room"], floor=Floor(**_tuples(floor)))
+        if room.get("wall_photo") is not None:
+            room["wall_photo"] = Photo(**_tuples(room["wall_photo"]))
         return cls(
             name=d["name"],
             room=Room(**_tuples(room)),
@@ -323,9 +326,9 @@ def _validate(spec: SceneSpec) -> None:
             raise ValueError(f"{spec.name}: chair {o.name}'s seat must lie between the floor and its top")
     albedos = [spec.room.wall_albedo, spec.room.ceiling_albedo, spec.room.floor.color1,
                spec.room.floor.color2] + [o.albedo for o in spec.objects]
-    photo = spec.room.floor.photo
-    if photo is not None and not (0.0 < photo.median < photo.ceiling < 1.0):
-        raise ValueError(f"{spec.name}: a photo floor's median and ceiling must rise in (0, 1)")
+    for photo in (spec.room.floor.photo, spec.room.wall_photo):
+        if photo is not None and not (0.0 < photo.median < photo.ceiling < 1.0):
+            raise ValueError(f"{spec.name}: a photograph's median and ceiling must rise in (0, 1)")
     if not all(0.0 <= c < 1.0 for a in albedos for c in a):
         raise ValueError(f"{spec.name}: albedos must lie in [0, 1)")
 
@@ -757,6 +760,25 @@ def _hotel_chair() -> SceneSpec:
     )
 
 
+def _hotel_walls() -> SceneSpec:
+    # Floor and walls from the hotel photograph, seen from near where it was taken: a box the
+    # size of the armchair's proxy on the wood between the rug and the desk chair.
+    photo = {"source": "interior.exr", "height": 1.5}
+    room = Room(lo=(-1.4, -1.2, 0.0), hi=(1.8, 2.4, 2.6), floor=Floor("photo", photo=Photo(**photo)),
+                wall_photo=Photo(**photo, median=0.55, texel=0.02))
+    return SceneSpec(
+        name="hotel_walls",
+        room=room,
+        lamps=(Lamp((-0.5, 1.5), (0.3, 0.3), 30.0, (1.0, 0.9, 0.75)), Lamp((0.6, -0.4), (0.3, 0.3), 20.0)),
+        objects=(SceneObject("Armchair", "box", (0.68, 0.7, 0.8), _on_floor(room, -0.75, 0.95), (0.5, 0.5, 0.12),
+                             rotation_z=5.0),),
+        probe=(0.1, 0.0, 1.5),
+        remove="Armchair",
+        render=_PHOTO_RENDER,
+        windows=(Window("east", (0.5, 1.4), (1.6, 1.7), 5.0, (1.0, 0.97, 0.92)),),
+    )
+
+
 def _apartment_chair() -> SceneSpec:
     # The empty apartment's wood floor with its sunlit patch, the window in the south wall where
     # the photograph's is; a light chair turned towards the room.
@@ -831,6 +853,7 @@ def _workshop_box() -> SceneSpec:
 PHOTO_SPECS: dict[str, SceneSpec] = {s.name: s for s in (
     _hotel_box(),
     _hotel_chair(),
+    _hotel_walls(),
     _apartment_chair(),
     _lobby_stool(),
     _warehouse_box(),

@@ -63,11 +63,11 @@ def test_fields_added_for_photo_rooms_leave_the_other_keys_alone() -> None:
     for spec in S.SPECS.values():
         text = spec.to_json()
         assert not spec.extended()
-        assert '"windows"' not in text and '"photo"' not in text and '"seat_height"' not in text
+        assert not any(f'"{name}"' in text for name in ("windows", "photo", "wall_photo", "seat_height"))
     for spec in S.PHOTO_SPECS.values():
         assert spec.extended() and spec.room.floor.photo is not None
         plain = dataclasses.replace(spec, windows=(), room=dataclasses.replace(
-            spec.room, floor=S.Floor()), objects=tuple(
+            spec.room, floor=S.Floor(), wall_photo=None), objects=tuple(
             dataclasses.replace(o, kind="box", seat_height=None) for o in spec.objects))
         assert not plain.extended()
 
@@ -142,9 +142,13 @@ def test_every_photo_room_builds() -> None:
         "    objects = bpy.context.scene.objects\n"
         "    floor = objects['Floor'].active_material.node_tree.nodes\n"
         "    images = [n.image for n in floor if n.bl_idname == 'ShaderNodeTexImage']\n"
+        "    walls = [o for o in objects if o.name.startswith('Wall.')]\n"
+        "    textured = [any(n.bl_idname == 'ShaderNodeTexImage' for n in o.active_material.node_tree.nodes)\n"
+        "                for o in walls]\n"
         "    res[name] = {'names': sorted(o.name for o in objects),\n"
         "                 'faces': {o.name: len(o.data.polygons) for o in objects if o.type == 'MESH'},\n"
-        "                 'floor_image': [(i.size[0], i.size[1], i.packed_file is not None) for i in images]}\n"
+        "                 'floor_image': [(i.size[0], i.size[1], i.packed_file is not None) for i in images],\n"
+        "                 'walls_textured': textured}\n"
         "print(json.dumps(res))\n")
     built = json.loads(out.strip().splitlines()[-1])
     for name, spec in S.PHOTO_SPECS.items():
@@ -153,6 +157,7 @@ def test_every_photo_room_builds() -> None:
         # The photograph's texture, packed, one texel per `texel` metres of floor.
         photo, (x0, y0, _), (x1, y1, _) = spec.room.floor.photo, spec.room.lo, spec.room.hi
         assert built[name]["floor_image"] == [[round((x1 - x0) / photo.texel), round((y1 - y0) / photo.texel), True]]
+        assert built[name]["walls_textured"] == [spec.room.wall_photo is not None] * 4
         for k, window in enumerate(spec.windows, start=1):
             assert {f"Window.{k:03d}", f"WindowHousing.{k:03d}"} <= names
             assert (f"Sun.{k:03d}" in names) == (window.sun_strength > 0)
