@@ -56,9 +56,8 @@ class HiddenLight:
 def hidden_light(solution: Solution, revealed: Revealed, callbacks: RunCallbacks) -> HiddenLight:
     """The irradiance after the removal at the revealed pixels (light transport: the report's
     stage `hidden_light`, apart from the synthesis that `fill_hidden` adds to it)."""
-    geo, room = solution.geo, solution.room
-    fine = fine_light(geo, solution.target, room, solution.occlusion, solution.db, solution.split, revealed.tri,
-                      revealed.bary, callbacks)
+    room = solution.room
+    fine = fine_light(solution.lit, revealed.tri, revealed.bary, callbacks)
     patch, _, _ = room.patches.lattice.locate(revealed.tri, revealed.bary)
     emit = room.emitter[patch]
     emitted = np.zeros((len(patch), 3))

@@ -55,6 +55,23 @@ class _Refine:
     spread: np.ndarray  # how much its neighbours' dE / E differ; inf where the pixel must be refined
     beside: np.ndarray  # bool: beside the object's silhouette (its light is computed at the pixel itself)
 
+    def take(self, chosen: np.ndarray) -> _Refine:
+        return _Refine(*(getattr(self, f)[chosen] for f in _Refine.__dataclass_fields__))
+
+
+@dataclass(frozen=True)
+class _Canvas:
+    """The full-resolution panorama `hdri` (H, W, 3) and what the light stages write for it:
+    the `difference` (H, W, 3) float32 and, over the object's `window`, the irradiance
+    `window_e` with the object (None without a window); `e_ref` is what "E is ~0" is relative
+    to."""
+
+    hdri: np.ndarray
+    difference: np.ndarray
+    window: ObjectWindow | None
+    window_e: np.ndarray | None
+    e_ref: float
+
 
 def full_resolution(solution: Solution, hdri: np.ndarray, rep: Report, callbacks: RunCallbacks) -> FullResolution:
     """Apply the working `solution` to the full-resolution panorama `hdri` (H, W, 3)."""
@@ -67,14 +84,15 @@ def full_resolution(solution: Solution, hdri: np.ndarray, rep: Report, callbacks
     if window is not None:
         rep.info["object_window"] = list(window.hidden.shape[::-1])  # width, height
     apply = ~solution.traced.hidden_h & ~solution.room.pixels.emitter_h
-    e_ref = reference_irradiance(solution.e_h, apply)
-    difference = np.zeros((height, width, 3), dtype=np.float32)
-    window_e = None if window is None else np.zeros((*window.hidden.shape, 3), dtype=np.float32)
+    canvas = _Canvas(hdri=hdri, difference=np.zeros((height, width, 3), dtype=np.float32), window=window,
+                     window_e=None if window is None else np.zeros((*window.hidden.shape, 3), dtype=np.float32),
+                     e_ref=reference_irradiance(solution.e_h, apply))
+    difference, window_e, e_ref = canvas.difference, canvas.window_e, canvas.e_ref
     with rep.stage("upsample"):
-        refine = _upsample(solution, maps, window, hdri, difference, window_e, e_ref, rep, callbacks)
+        refine = _upsample(solution, maps, canvas, rep, callbacks)
     callbacks.check()
     with rep.stage("refine"):
-        _refine(solution, refine, hdri, difference, window, window_e, e_ref, rep, callbacks)
+        _refine(solution, refine, canvas, rep, callbacks)
     hidden_mask = np.zeros(full, dtype=bool)
     if window is None:
         rep.skip("relit_noise", "the object is not visible from the probe centre: no window to measure noise in")
@@ -136,10 +154,10 @@ def _window_pixels(window: ObjectWindow) -> tuple[np.ndarray, np.ndarray]:
     return rows, cols
 
 
-def _upsample(solution: Solution, maps: WorkingMaps, window: ObjectWindow | None, hdri: np.ndarray,
-              difference: np.ndarray, window_e: np.ndarray | None, e_ref: float, rep: Report,
-              callbacks: RunCallbacks) -> _Refine:
+def _upsample(solution: Solution, maps: WorkingMaps, canvas: _Canvas, rep: Report, callbacks: RunCallbacks
+              ) -> _Refine:
     """Write the upsampled change band by band; the pixels left to refine."""
+    hdri, difference, window, window_e = canvas.hdri, canvas.difference, canvas.window, canvas.window_e
     height, width = hdri.shape[:2]
     grid = cells(maps)
     top, bottom = Cells.rows(maps)
@@ -186,7 +204,7 @@ def _upsample(solution: Solution, maps: WorkingMaps, window: ObjectWindow | None
         pixels.look_up(solution, maps, rows, width, height, np.flatnonzero(sharp & ~pixels.known))
         refine |= sharp & (pixels.tri >= 0)
         radiance = clamped_rows(hdri, rows[0], rows[-1] + 1).reshape(-1, 3)
-        d = ratio_change(radiance, e, de, served, e_ref=e_ref, rep=rep)
+        d = ratio_change(radiance, e, de, served, e_ref=canvas.e_ref, rep=rep)
         difference[rows[0]:rows[-1] + 1] = d.reshape(-1, width, 3)
         if window_e is not None and len(pixels.window_index):
             window_e[pixels.window_rows, pixels.window_cols] = e[pixels.window_index]
@@ -285,9 +303,7 @@ def _mixed(solution: Solution, maps: WorkingMaps, pixels: _BandPixels, rows: np.
     return _Mixed(e, de, served, needed)
 
 
-def _refine(solution: Solution, refine: _Refine, hdri: np.ndarray, difference: np.ndarray,
-            window: ObjectWindow | None, window_e: np.ndarray | None, e_ref: float, rep: Report,
-            callbacks: RunCallbacks) -> None:
+def _refine(solution: Solution, refine: _Refine, canvas: _Canvas, rep: Report, callbacks: RunCallbacks) -> None:
     """Give the pixels to refine their own light (the sharp-edge ones up to the preset's budget)."""
     needed = np.isinf(refine.spread)
     optional = np.flatnonzero(~needed)
@@ -299,36 +315,33 @@ def _refine(solution: Solution, refine: _Refine, hdri: np.ndarray, difference: n
     for beside in (True, False):
         chosen = keep & (refine.beside == beside)
         if chosen.any():
-            _refined_light(solution, refine.pixel[chosen], refine.tri[chosen], refine.bary[chosen],
-                           refine.distance[chosen], hdri, difference, window, window_e, e_ref, rep, callbacks,
-                           per_point=beside)
+            _refined_light(solution, refine.take(chosen), canvas, rep, callbacks, per_point=beside)
 
 
-def _refined_light(solution: Solution, pixel: np.ndarray, tri: np.ndarray, bary: np.ndarray, distance: np.ndarray,
-                   hdri: np.ndarray, difference: np.ndarray, window: ObjectWindow | None, window_e: np.ndarray | None,
-                   e_ref: float, rep: Report, callbacks: RunCallbacks, *, per_point: bool) -> None:
-    """Write the change of full-resolution pixels (flat `pixel`, seeing `tri` at `bary` and
-    `distance`) from their own light."""
+def _refined_light(solution: Solution, refine: _Refine, canvas: _Canvas, rep: Report, callbacks: RunCallbacks, *,
+                   per_point: bool) -> None:
+    """Write the change of full-resolution pixels (`refine`: flat pixel, the triangle it sees at
+    its barycentric weights and distance) from their own light."""
+    pixel, tri, bary, hdri = refine.pixel, refine.tri, refine.bary, canvas.hdri
     height, width = hdri.shape[:2]
     rows, cols = np.divmod(pixel, width)
     room, geo, target = solution.room, solution.geo, solution.target
-    points = latlong.pixel_directions_at(rows, cols, width, height) * distance[:, None]
+    points = latlong.pixel_directions_at(rows, cols, width, height) * refine.distance[:, None]
     patch, corners, weights = room.patches.lattice.locate(tri, bary)
     relit = ~room.emitter[patch]
     if target.planes:
         relit &= np.isin(geo.tri_object[tri], target.planes)
     receiving = Receiving(points=points, normals=geo.normals[tri], tri=tri, bary=bary,
                           corners=room.receivers.vertex_row[corners], weights=weights, relit=relit)
-    light = light_at(geo, target, receiving, solution.occlusion, room, solution.db, solution.split, solution.params,
-                     callbacks, per_point=per_point)
+    light = light_at(solution.lit, receiving, solution.params, callbacks, per_point=per_point)
     key = "refined_exact_pairs"
     rep.info[key] = rep.info.get(key, 0) + light.exact_pairs
     radiance = np.maximum(hdri.reshape(-1, 3)[pixel].astype(np.float64), 0.0)
-    difference.reshape(-1, 3)[pixel] = ratio_change(radiance, light.e, light.de, ~room.emitter[patch], e_ref=e_ref,
-                                                    rep=rep)
-    if window is not None and window_e is not None:
-        wr, wc, inside = window.holds(rows, cols)
-        window_e[wr[inside], wc[inside]] = light.e[inside]
+    canvas.difference.reshape(-1, 3)[pixel] = ratio_change(radiance, light.e, light.de, ~room.emitter[patch],
+                                                           e_ref=canvas.e_ref, rep=rep)
+    if canvas.window is not None and canvas.window_e is not None:
+        wr, wc, inside = canvas.window.holds(rows, cols)
+        canvas.window_e[wr[inside], wc[inside]] = light.e[inside]
 
 
 @dataclass(frozen=True)

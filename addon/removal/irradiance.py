@@ -7,13 +7,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..callbacks import RunCallbacks
-from ..geometry.mesh import Geometry
 from ..geometry.patches import build_lattice, levels_for_size
 from ..light.split import Split
 from .interpolation import inset
-from .occlusion import Occlusion
+from .lit_room import LitRoom
 from .room import Room
-from .target import Target
 
 
 def before_and_after(room: Room, db: np.ndarray, split: Split, t: np.ndarray, t_w: np.ndarray,
@@ -37,34 +35,33 @@ class FineLight:
     weights: np.ndarray  # (N, 3) their weights
 
 
-def fine_light(geo: Geometry, target: Target, room: Room, occlusion: Occlusion, db: np.ndarray, split: Split,
-               tri: np.ndarray, bary: np.ndarray, callbacks: RunCallbacks) -> FineLight:
+def fine_light(lit: LitRoom, tri: np.ndarray, bary: np.ndarray, callbacks: RunCallbacks) -> FineLight:
     """Light at the vertices of a fine lattice (cells of about the target's `fine_cell`) over
     the triangles `tri`: only the vertices that the points (tri, bary) interpolate from."""
+    geo = lit.geo
     tris_r = np.unique(tri)
     levels = np.zeros(len(geo.triangles), dtype=np.int64)
-    levels[tris_r] = levels_for_size(geo.triangles[tris_r], target.fine_cell, max_level=512)
+    levels[tris_r] = levels_for_size(geo.triangles[tris_r], lit.target.fine_cell, max_level=512)
     fine = build_lattice(geo.triangles, levels)
     _, corners, weights = fine.locate(tri, bary)
     needed, inverse = np.unique(corners, return_inverse=True)
     callbacks.check()
     points = inset(fine.vertices[needed], geo.triangles[fine.vertex_tri[needed]])
-    return _light_of(points, geo.normals[fine.vertex_tri[needed]], room, occlusion, db, split,
-                     inverse.reshape(corners.shape), weights, callbacks)
+    return _light_of(points, geo.normals[fine.vertex_tri[needed]], lit, inverse.reshape(corners.shape), weights,
+                     callbacks)
 
 
-def point_light(points: np.ndarray, normals: np.ndarray, room: Room, occlusion: Occlusion, db: np.ndarray,
-                split: Split, callbacks: RunCallbacks) -> FineLight:
+def point_light(points: np.ndarray, normals: np.ndarray, lit: LitRoom, callbacks: RunCallbacks) -> FineLight:
     """Light at the points (N, 3) themselves, each its own vertex: for the few pixels where
     even a fine lattice would blur what they show (beside the object's silhouette)."""
     n = len(points)
-    return _light_of(points, normals, room, occlusion, db, split, np.repeat(np.arange(n)[:, None], 3, axis=1),
+    return _light_of(points, normals, lit, np.repeat(np.arange(n)[:, None], 3, axis=1),
                      np.repeat([[1.0, 0.0, 0.0]], n, axis=0), callbacks)
 
 
-def _light_of(points: np.ndarray, normals: np.ndarray, room: Room, occlusion: Occlusion, db: np.ndarray,
-              split: Split, corners: np.ndarray, weights: np.ndarray, callbacks: RunCallbacks) -> FineLight:
-    t_with, t_without = occlusion.transport(points, normals, room.senders, callbacks)
-    e, e_after = before_and_after(room, db, split, t_with, t_without,
-                                  *occlusion.transport(points, normals, split.senders, callbacks))
+def _light_of(points: np.ndarray, normals: np.ndarray, lit: LitRoom, corners: np.ndarray, weights: np.ndarray,
+              callbacks: RunCallbacks) -> FineLight:
+    t_with, t_without = lit.occlusion.transport(points, normals, lit.room.senders, callbacks)
+    e, e_after = before_and_after(lit.room, lit.db, lit.split, t_with, t_without,
+                                  *lit.occlusion.transport(points, normals, lit.split.senders, callbacks))
     return FineLight(t_with, t_without, e, e_after, corners, weights)

@@ -8,17 +8,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..callbacks import RunCallbacks
-from ..geometry.mesh import Geometry
 from ..light.formfactor import paired_point_to_triangle
 from ..light.planner import neighbourhood
-from ..light.split import Split
 from ..light.transport import pair_visibility
 from ..quality import Params
 from ..report import Report
 from .interpolation import interpolate
 from .irradiance import before_and_after, fine_light, point_light
+from .lit_room import LitRoom
 from .occlusion import Occlusion
-from .propagation import Propagation
 from .room import Room
 from .significance import significant
 from .target import Target
@@ -58,11 +56,9 @@ def traced_receiving(traced: Traced, room: Room, target: Target) -> Receiving:
                      weights=room.pixels.weights_h, relit=relit)
 
 
-def local_light(geo: Geometry, target: Target, traced: Traced, occlusion: Occlusion, room: Room,
-                propagation: Propagation, params: Params, rep: Report, callbacks: RunCallbacks) -> LocalLight:
+def local_light(lit: LitRoom, traced: Traced, params: Params, rep: Report, callbacks: RunCallbacks) -> LocalLight:
     """Per-pixel E and dE after removal, exact where the object's shadow of a light falls."""
-    light = light_at(geo, target, traced_receiving(traced, room, target), occlusion, room, propagation.db,
-                     propagation.split, params, callbacks)
+    light = light_at(lit, traced_receiving(traced, lit.room, lit.target), params, callbacks)
     rep.info["affected_pixels"] = light.affected
     if light.affected == 0:
         rep.skip("local", "the object neither shadows nor lights any visible surface")
@@ -84,12 +80,12 @@ class PointLight:
     exact_pairs: int
 
 
-def light_at(geo: Geometry, target: Target, receiving: Receiving, occlusion: Occlusion, room: Room, db: np.ndarray,
-             split: Split, params: Params, callbacks: RunCallbacks, *, per_point: bool = False) -> PointLight:
-    """E and dE at the receiving points, exact where the object's shadow of a light falls,
-    given the change db (P, 3) of the patches with every bounce and the split patches. Near
+def light_at(lit: LitRoom, receiving: Receiving, params: Params, callbacks: RunCallbacks, *,
+             per_point: bool = False) -> PointLight:
+    """E and dE at the receiving points, exact where the object's shadow of a light falls. Near
     the object the light comes from a fine lattice, or with `per_point` from each point's own
     transport."""
+    room, target = lit.room, lit.target
     b = room.senders.radiosity
     imp = np.flatnonzero(room.important)
     corners_h, weights_h = receiving.corners, receiving.weights
@@ -98,7 +94,8 @@ def light_at(geo: Geometry, target: Target, receiving: Receiving, occlusion: Occ
     def change(e: np.ndarray, e_after: np.ndarray, t: np.ndarray, t_w: np.ndarray) -> np.ndarray:
         return e_after - e - (t_w - t)[:, imp] @ b[imp]
 
-    e_v, ea_v = before_and_after(room, db, split, room.t_with, room.t_without, split.t_with, split.t_without)
+    split = lit.split
+    e_v, ea_v = before_and_after(room, lit.db, split, room.t_with, room.t_without, split.t_with, split.t_without)
     e_h = interpolate(e_v, corners_h, weights_h)
     de_h = interpolate(change(e_v, ea_v, room.t_with, room.t_without), corners_h, weights_h)
 
@@ -119,10 +116,8 @@ def light_at(geo: Geometry, target: Target, receiving: Receiving, occlusion: Occ
     near_pixels = candidate[near]
     fine_vertices = 0
     if len(near_pixels):
-        fine = (point_light(receiving.points[near_pixels], receiving.normals[near_pixels], room, occlusion, db,
-                            split, callbacks) if per_point else
-                fine_light(geo, target, room, occlusion, db, split, receiving.tri[near_pixels],
-                           receiving.bary[near_pixels], callbacks))
+        fine = (point_light(receiving.points[near_pixels], receiving.normals[near_pixels], lit, callbacks)
+                if per_point else fine_light(lit, receiving.tri[near_pixels], receiving.bary[near_pixels], callbacks))
         fine_vertices = len(fine.t_with)
         e_h[near_pixels] = interpolate(fine.e, fine.corners, fine.weights)
         de_h[near_pixels] = interpolate(change(fine.e, fine.e_after, fine.t_with, fine.t_without), fine.corners,
@@ -132,7 +127,7 @@ def light_at(geo: Geometry, target: Target, receiving: Receiving, occlusion: Occ
         in_fine = row[pix] >= 0
         k = row[pix[in_fine]]
         lattice_e[in_fine] = (fine.weights[k] * fine.t_with[fine.corners[k], s[in_fine, None]]).sum(axis=1)
-    _add_exact_shadows(e_h, de_h, receiving, occlusion, room, pix, s, lattice_e, callbacks)
+    _add_exact_shadows(e_h, de_h, receiving, lit.occlusion, room, pix, s, lattice_e, callbacks)
     return PointLight(e_h, de_h, affected, fine_vertices, len(s))
 
 

@@ -26,6 +26,7 @@ from .compose import compose
 from .fill import fill_hidden, hidden_light, working_measured, working_revealed
 from .first_order import first_order
 from .full_resolution import full_resolution
+from .lit_room import LitRoom
 from .local import local_light
 from .occlusion import occluders
 from .propagation import propagate_change
@@ -104,11 +105,11 @@ def solve_lighting(hdri: np.ndarray, geo: Geometry, target: Target, traced: Trac
     with rep.stage("propagation"):
         propagation = propagate_change(first, occlusion, params, rep, callbacks)
     callbacks.check()
+    lit = LitRoom(geo=geo, target=target, occlusion=occlusion, room=first.room, db=propagation.db,
+                  split=propagation.split)
     with rep.stage("local"):
-        local = local_light(geo, target, traced, occlusion, first.room, propagation, params, rep, callbacks)
-    return Solution(hdri=hdri, params=params, geo=geo, target=target, traced=traced, occlusion=occlusion,
-                    room=first.room, db=propagation.db, split=propagation.split, e_h=local.e_h, de_h=local.de_h,
-                    seen=seen)
+        local = local_light(lit, traced, params, rep, callbacks)
+    return Solution(hdri=hdri, params=params, lit=lit, traced=traced, e_h=local.e_h, de_h=local.de_h, seen=seen)
 
 
 def solve(scene: SceneData, object_name: str, planes: list[str] | tuple[str, ...], params: Params, rep: Report,

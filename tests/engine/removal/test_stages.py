@@ -20,6 +20,7 @@ from addon.removal import finish, solve_lighting
 from addon.removal.compose import compose
 from addon.removal.fill import fill_hidden, hidden_light, working_revealed
 from addon.removal.first_order import first_order
+from addon.removal.lit_room import LitRoom
 from addon.removal.local import local_light
 from addon.removal.occlusion import occluders
 from addon.removal.propagation import propagate_change
@@ -74,7 +75,9 @@ def stages():
     room = keep("room", solve_room(scene.hdri, geo, target, traced, occlusion, PARAMS, rep, NO_CALLBACKS))
     first = keep("first", first_order(room, target, occlusion, PARAMS, rep, NO_CALLBACKS))
     propagation = keep("propagation", propagate_change(first, occlusion, PARAMS, rep, NO_CALLBACKS))
-    keep("local", local_light(geo, target, traced, occlusion, first.room, propagation, PARAMS, rep, NO_CALLBACKS))
+    lit = keep("lit", LitRoom(geo=geo, target=target, occlusion=occlusion, room=first.room, db=propagation.db,
+                              split=propagation.split))
+    keep("local", local_light(lit, traced, PARAMS, rep, NO_CALLBACKS))
     solution = keep("solution", solve_lighting(scene.hdri, geo, target, traced, PARAMS, Report(), NO_CALLBACKS))
     out["finished"] = finish(solution, Report())
     out["fingerprints"] = fingerprints
