@@ -5,6 +5,7 @@
     python -m addon.cli align SCENE.blend --object NAME --out DIR [--save COPY.blend] [options]
     blender -b SCENE.blend -c dimred remove|relocate|align ... (the same arguments)
     python -m addon.cli batch JOBS --out DIR ...  and  inspect SCENE.blend ... (`batch_cli`)
+    python -m addon.cli room [SCENE.blend] --clicks CLICKS.json --save OUT.blend --out DIR (`room_cli`)
 
 Both run `run_cli`; inside Blender the .blend is already open, so SCENE.blend is optional.
 Bad input gets one line `dimred: error: ...` on stderr, exit code 2, and nothing on disk.
@@ -22,7 +23,7 @@ from .. import memory
 from ..callbacks import RunCallbacks
 from ..errors import DimredError
 from ..quality import DEFAULT_QUALITY, DESCRIPTIONS, MIN_WORKING_WIDTH, PRESETS, working_width_problem
-from . import batch_cli
+from . import batch_cli, room_cli
 
 if TYPE_CHECKING:
     from ..removal import RemovalResult
@@ -160,6 +161,7 @@ def build_parser(*, blend_already_loaded: bool) -> argparse.ArgumentParser:
     align.set_defaults(run=_align)
     batch_cli.add_commands(commands, formatter=argparse.RawDescriptionHelpFormatter,
                            inside_blender=blend_already_loaded)
+    room_cli.add_command(commands, formatter=argparse.RawDescriptionHelpFormatter, inside_blender=blend_already_loaded)
     return parser
 
 
