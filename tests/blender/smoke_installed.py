@@ -222,6 +222,18 @@ def room_run(blend: Path, hdri_path: Path) -> None:
         assert np.min(np.linalg.norm(found[:, :2] - probe[:2] - corner, axis=1)) < 0.25 * np.linalg.norm(corner)
 
 
+def room_command_run(command: Callable[[list[str]], int], work: Path) -> None:
+    """`blender -c dimred room` on the open scene, with the clicks the last step kept on it."""
+    import bpy
+
+    clicks = work / "room_clicks.json"
+    clicks.write_text(bpy.context.scene["dimred_room_clicks"])
+    saved, out = work / "room_copy.blend", work / "room_out"
+    assert command(["room", "--clicks", str(clicks), "--save", str(saved), "--out", str(out)]) == 0
+    assert saved.is_file() and sorted(p.name for p in out.iterdir()) == ["room.json", "room_diagnostics.png"]
+    assert json.loads((out / "room.json").read_text())["room"]["camera_height_m"] == 1.2
+
+
 def main(argv: list[str]) -> int:
     work = Path(tempfile.mkdtemp(prefix="dimred-smoke-"))
     # Before bpy is imported: Blender reads its user folders once, at start-up.
@@ -258,6 +270,8 @@ def main(argv: list[str]) -> int:
         step("bpy.ops.dimred.relocate: the box moved and the layer written, clear puts it back", relocate_run, blend)
         step("bpy.ops.dimred.room_click and match_room: Floor, Walls and Ceiling read back", room_run, blend,
              hdri_path)
+        step("blender -c dimred room: the room saved in a copy, room.json and its picture", room_command_run,
+             command, work)
     except Exception:
         pass  # step() printed it; every later step depends on this one
     if failed:

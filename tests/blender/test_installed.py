@@ -15,4 +15,4 @@ SCRIPT = Path(__file__).resolve().parent / "smoke_installed.py"
 def test_installed_extension_removes_renders_and_undoes():
     result = subprocess.run([sys.executable, str(SCRIPT)], capture_output=True, text=True, timeout=600)
     assert result.returncode == 0, result.stdout[-4000:] + result.stderr[-2000:]
-    assert "smoke: 10 passed, 0 failed" in result.stdout
+    assert "smoke: 11 passed, 0 failed" in result.stdout
