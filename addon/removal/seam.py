@@ -34,6 +34,8 @@ _ALIKE = 4.0  # within this factor of the boundary's median luminance: the surfa
 # steps' averaging along the boundary and the surface's own steps around it all lie within.
 _WINDOW_REACHES = 4
 _AROUND = 2  # reaches: the surface around the hole whose own steps are measured
+
+
 def seamless_change(radiance: np.ndarray, change: np.ndarray, filled: np.ndarray, surface: np.ndarray
                     ) -> np.ndarray:
     """(h, w, 3) `change` with the `filled` pixels' (h, w) step against the rest taken out, per
@@ -41,6 +43,7 @@ def seamless_change(radiance: np.ndarray, change: np.ndarray, filled: np.ndarray
     photograph `radiance` (h, w, 3). Nothing changes outside `filled`; no radiance goes below 0."""
     out = np.array(change, dtype=np.float32, copy=True)
     edited = np.maximum(radiance, 0.0) + out
+    luma = edited @ LUMA
     for s in np.unique(surface[filled]):
         if s < 0:
             continue
@@ -59,10 +62,9 @@ def seamless_change(radiance: np.ndarray, change: np.ndarray, filled: np.ndarray
         if not boundary.any():
             continue
         # The surface's own steps are those of its material: not a desk or a rug's stripes beside it.
-        luma = edited @ LUMA
         typical = float(np.median(luma[outer]))
         alike = (luma > typical / _ALIKE) & (luma < typical * _ALIKE)
-        spread = _step_spread(edited, outside & alike & dilate(inside, _AROUND * reach), reach, band)
+        spread = _step_spread(luma, outside & alike & dilate(inside, _AROUND * reach), reach, band)
         step, _ = box_mean(np.where(boundary[..., None], m_out - m_in, 0.0), boundary, _ALONG * reach)
         kept = np.clip(1 - (_SIGNIFICANCE * spread / np.maximum(np.abs(step @ LUMA), 1e-30)) ** 2, 0.0, 1.0)
         membrane = _pull_push(np.where(boundary[..., None], step * kept[..., None], 0.0), boundary)
@@ -71,21 +73,20 @@ def seamless_change(radiance: np.ndarray, change: np.ndarray, filled: np.ndarray
     return out
 
 
-def _step_spread(edited: np.ndarray, around: np.ndarray, reach: int, band: int) -> float:
-    """How much the luminance's means over two adjacent strips `band` deep and `2 reach + 1`
+def _step_spread(luma: np.ndarray, around: np.ndarray, reach: int, band: int) -> float:
+    """How much the luminance `luma`'s (h, w) means over two adjacent strips `band` deep and `2 reach + 1`
     long (across or along the rows) differ where both lie mostly on the pixels `around`: the
     steps the surface shows by itself between bands like the boundary's, its light and texture.
     A high quantile, robust to a desk or a rug beside the hole being a minority of the pairs;
     infinite where too few such pairs are there."""
-    luma = (edited @ LUMA) * around
+    luma = luma * around
     half = band // 2
     apart = 2 * half + 1
     steps = []
-    for sizes in ((half, reach), (reach, half)):
+    for axis, sizes in ((0, (half, reach)), (1, (reach, half))):
         total, count = rect_sum(luma, *sizes), rect_sum(around.astype(np.float64), *sizes)
         full = count >= 0.5 * (2 * sizes[0] + 1) * (2 * sizes[1] + 1)
         mean = total / np.maximum(count, 1e-12)
-        axis = 0 if sizes[0] == half else 1
         first = [slice(None), slice(None)]
         second = [slice(None), slice(None)]
         first[axis], second[axis] = slice(None, -apart), slice(apart, None)
