@@ -175,3 +175,9 @@ def surface_keys(geometry: Geometry, *, angle_tolerance: float = 1e-3) -> np.nda
         axis=1,
     )
     return np.unique(key, axis=0, return_inverse=True)[1].ravel()
+
+
+def surfaces_of(keys: np.ndarray, tri: np.ndarray) -> np.ndarray:
+    """The surface key (`keys`, per triangle) of each triangle index in `tri`, -1 where it is -1
+    (nothing hit), in the keys' dtype."""
+    return np.where(tri >= 0, keys[np.maximum(tri, 0)], -1)

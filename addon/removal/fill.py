@@ -10,7 +10,7 @@ import numpy as np
 
 from ..callbacks import RunCallbacks
 from ..geometry import latlong
-from ..geometry.mesh import Geometry
+from ..geometry.mesh import Geometry, surfaces_of
 from ..geometry.planeraster import edge_direction
 from ..light.radiosity import LUMA, RHO_MAX
 from ..report import Report
@@ -186,8 +186,7 @@ def _panorama_reflectance(solution: Solution, radiance: np.ndarray) -> PanoramaR
     shape = (traced.height, traced.width)
     surface_with = np.full(n, -1, dtype=np.int64)
     surface_with[traced.hp] = keys[traced.tri_h]
-    tri_without = traced.behind.tri_without
-    surface_without = np.where(tri_without >= 0, keys[np.maximum(tri_without, 0)], -1)
+    surface_without = surfaces_of(keys, traced.behind.tri_without)
     maps = PanoramaMaps(surface_with.reshape(shape), traced.hits.distance, surface_without.reshape(shape),
                         traced.behind.distance_without.reshape(shape), traced.hidden_map)
     measured = working_measured(solution)

@@ -16,6 +16,7 @@ import numpy as np
 
 from ..callbacks import RunCallbacks
 from ..geometry import latlong
+from ..geometry.mesh import surfaces_of
 from ..geometry.planeraster import PlaneRaster, build_raster
 from ..light.radiosity import LUMA
 from ..radiance import clamped_rows
@@ -255,7 +256,7 @@ class _BandPixels:
         pixels.tri[index] = window.tri[wr, wc]
         pixels.bary[index] = window.bary[wr, wc]
         pixels.distance[index] = np.where(pixels.tri[index] >= 0, window.distance[wr, wc], 0.0)
-        pixels.own[index] = np.where(pixels.tri[index] >= 0, keys[np.maximum(pixels.tri[index], 0)], -1)
+        pixels.own[index] = surfaces_of(keys, pixels.tri[index])
         pixels.own[pixels.hidden] = -1
         return pixels
 
@@ -268,7 +269,7 @@ class _BandPixels:
         near = neighbours(r, c, (height, width), maps)
         found = surfaces_seen(latlong.pixel_directions_at(r, c, width, height), near.nearest, solution.geo, maps)
         self.tri[index], self.bary[index], self.distance[index] = found.tri, found.bary, found.distance
-        self.own[index] = np.where(found.tri >= 0, self.keys[np.maximum(found.tri, 0)], -1)
+        self.own[index] = surfaces_of(self.keys, found.tri)
         self.known[index] = True
 
 
@@ -362,7 +363,7 @@ def _window_surfaces(solution: Solution, window: ObjectWindow, window_e: np.ndar
     patch, _, _ = solution.room.patches.lattice.locate(window.tri[room_hit], window.bary[room_hit].astype(np.float64))
     emitter[room_hit] = solution.room.emitter[patch]
     measured = ~window.hidden & room_hit & ~emitter & ((window_e @ LUMA.astype(np.float32)) > 1e-3 * e_ref)
-    return _WindowSurfaces(without=np.where(window.tri >= 0, keys[np.maximum(window.tri, 0)], -1), measured=measured)
+    return _WindowSurfaces(without=surfaces_of(keys, window.tri), measured=measured)
 
 
 def _revealed(solution: Solution, window: ObjectWindow, window_e: np.ndarray, radiance: np.ndarray,
@@ -372,9 +373,7 @@ def _revealed(solution: Solution, window: ObjectWindow, window_e: np.ndarray, ra
     frame = window.frame
     rows, cols = _window_pixels(window)
     keys = solution.target.surface_key.astype(np.int32)
-    seen_tri = np.where(window.on_object, window.object_tri, window.tri)
-    surface_with = np.where(seen_tri >= 0, keys[np.maximum(seen_tri, 0)], -1)
-    del seen_tri
+    surface_with = surfaces_of(keys, np.where(window.on_object, window.object_tri, window.tri))
     distance_with = np.where(window.on_object, window.object_distance, window.distance)
     finite = np.isfinite(window.distance)
     maps = PanoramaMaps(surface_with, np.where(np.isfinite(distance_with), distance_with, 0.0), surfaces.without,

@@ -16,7 +16,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..callbacks import NO_CALLBACKS, RunCallbacks
-from ..geometry.mesh import Geometry, build_geometry
+from ..geometry.mesh import Geometry, build_geometry, surfaces_of
 from ..quality import Params
 from ..report import Report
 from ..scene import SceneData
@@ -210,8 +210,7 @@ def _seamless(solution: Solution, difference: np.ndarray) -> np.ndarray:
     shape = (traced.height, traced.width)
     filled = np.zeros(traced.height * traced.width, dtype=bool)
     filled[traced.hp[traced.behind.revealed]] = True
-    tri = traced.behind.tri_without
-    surface = np.where(tri >= 0, solution.target.surface_key[np.maximum(tri, 0)], -1).reshape(shape)
+    surface = surfaces_of(solution.target.surface_key, traced.behind.tri_without).reshape(shape)
     return seamless_panorama_change(np.asarray(solution.hdri, np.float32), difference, filled.reshape(shape), surface)
 
 
