@@ -229,15 +229,21 @@ def _added(image: np.ndarray, proxy: np.ndarray, seg: ObjectSegmentation, band: 
     if not added.any():
         return added
     # Smoothed twice: a render's or a sensor's noise would make every pixel's colour its own.
-    rgb = blur(blur(np.maximum(image, 0.0))).astype(np.float64) + 1e-6 * max(float(image.mean()), 1e-30)
-    log_y = np.log(rgb @ LUMA)
-    chroma = np.log(rgb[..., [0, 2]] / rgb[..., 1:2])
+    y, chroma = _colour(blur(blur(np.maximum(image, 0.0))), image)
+    log_y = np.log(y)
     around = ~seg.object & ~proxy & dilate(proxy, 2 * band)
     local, weight = box_mean(np.concatenate([log_y[..., None], chroma], axis=2), around, 2 * band)
     local_chroma = local[..., 1:]
     darker = log_y < local[..., 0] + np.log(_SHADOW)
     alike = np.abs(chroma - local_chroma).max(axis=2) < _SHADOW_CHROMA
     return added & ~(darker & alike & (weight > 0))
+
+
+def _colour(smoothed: np.ndarray, image: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Luminance (h, w) and log chromaticity (h, w, 2: red and blue against green) of a smoothed
+    copy of `image`, lifted by a millionth of the image's mean so that black has a colour."""
+    rgb = smoothed.astype(np.float64) + 1e-6 * max(float(image.mean()), 1e-30)
+    return rgb @ LUMA, np.log(rgb[..., [0, 2]] / rgb[..., 1:2])
 
 
 def _attached_dark(image: np.ndarray, shown: np.ndarray, band: int) -> np.ndarray:
@@ -253,9 +259,7 @@ def _attached_dark(image: np.ndarray, shown: np.ndarray, band: int) -> np.ndarra
         return np.zeros_like(shown)
     lower = (np.arange(shown.shape[0]) > np.median(rows))[:, None]
     # Smoothed once: a leg may be a few pixels wide.
-    rgb = blur(np.maximum(image, 0.0)).astype(np.float64) + 1e-6 * max(float(image.mean()), 1e-30)
-    y = rgb @ LUMA
-    chroma = np.log(rgb[..., [0, 2]] / rgb[..., 1:2])
+    y, chroma = _colour(blur(np.maximum(image, 0.0)), image)
     around = ~shown & dilate(shown, 2 * band) & lower
     if not around.any():
         return np.zeros_like(shown)
