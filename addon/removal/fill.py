@@ -109,13 +109,12 @@ def fill_hidden(solution: Solution, revealed: Revealed, light: HiddenLight, rep:
         if not got.synthesised:
             rep.warn(f"too little of '{name}' is seen around the object to synthesise its texture: "
                      f"{len(sel)} pixels get its mean reflectance")
-        if got.synthesised and got.material is not None and got.material.mostly_other:
+        if got.synthesised and got.material.mostly_other:
             rep.warn(_material_warning(name, got.material))
         surfaces.append({"surface": name, "pixels": len(sel), "raster": list(got.raster_shape),
                          "cell": round(got.cell, 5), "known_cells": got.known_cells, "hole_cells": got.hole_cells,
                          "synthesised": got.synthesised, "structured_cells": got.structured,
-                         "exemplar": None if got.material is None else got.material.source,
-                         "exemplar_share": None if got.material is None else round(got.material.share, 3),
+                         "exemplar": got.material.source, "exemplar_share": round(got.material.share, 3),
                          "seconds": round(seconds, 4)})
     rep.info["filled_surfaces"] = surfaces
     return change()

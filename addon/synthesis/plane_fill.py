@@ -106,8 +106,8 @@ class SurfaceFill:
     known_cells: int
     hole_cells: int
     synthesised: bool  # False: too little of the surface is seen; its mean reflectance is used
+    material: Material  # which seen cells served as exemplar
     structured: int = 0  # hole cells composed from shifted copies (the rest: order-independent synthesis)
-    material: Material | None = None  # which seen cells served as exemplar
 
 
 def fill_surface(
