@@ -47,13 +47,10 @@ def comparison(images: list[np.ndarray], mask: np.ndarray, *, zoom: int = 3) -> 
 
 
 def _sources(report: dict) -> str:
-    """The filled surfaces, each with its exemplars' source and their share of the surface where
-    the report has them ('exemplar', 'exemplar_share'), else whether it was synthesised."""
+    """The filled surfaces, each with its exemplars' source and their share of the surface, or
+    'mean' where too little was seen to synthesise."""
     def source(f: dict) -> str:
-        if f.get("exemplar") is None:
-            return "synthesised" if f["synthesised"] else "mean"
-        share = f.get("exemplar_share")
-        return f["exemplar"] if share is None else f"{f['exemplar']} {share:.0%}"
+        return f"{f['exemplar']} {f['exemplar_share']:.0%}" if f["synthesised"] else "mean"
 
     return ", ".join(f"{f['surface']}: {source(f)}" for f in report.get("filled_surfaces", [])) or "-"
 
