@@ -85,10 +85,10 @@ def full_resolution(solution: Solution, hdri: np.ndarray, rep: Report, callbacks
     if window is not None:
         rep.info["object_window"] = list(window.hidden.shape[::-1])  # width, height
     apply = ~solution.traced.hidden_h & ~solution.room.pixels.emitter_h
-    canvas = _Canvas(hdri=hdri, difference=np.zeros((height, width, 3), dtype=np.float32), window=window,
-                     window_e=None if window is None else np.zeros((*window.hidden.shape, 3), dtype=np.float32),
-                     e_ref=reference_irradiance(solution.e_h, apply))
-    difference, window_e, e_ref = canvas.difference, canvas.window_e, canvas.e_ref
+    e_ref = reference_irradiance(solution.e_h, apply)
+    difference = np.zeros((height, width, 3), dtype=np.float32)
+    window_e = None if window is None else np.zeros((*window.hidden.shape, 3), dtype=np.float32)
+    canvas = _Canvas(hdri=hdri, difference=difference, window=window, window_e=window_e, e_ref=e_ref)
     with rep.stage("upsample"):
         refine = _upsample(solution, maps, canvas, rep, callbacks)
     callbacks.check()
