@@ -6,6 +6,8 @@ Alt+click to move the nearest corner, Enter or right click to match, Esc to stop
 script with `kind`, `x` and `y`.
 `dimred.match_room` fits the room to the clicks (`addon.roommatch`), builds it, sets the probe
 centre and draws the room diagnostics picture. Click files (`dimred room`'s JSON) load and save.
+`dimred.object_from_photo` (one click inside an object) and `dimred.object_footprint` (its
+contact points with the floor) build the proxy of an object to remove and mark it.
 """
 from __future__ import annotations
 
@@ -13,7 +15,15 @@ import json
 
 import bpy
 import numpy as np
-from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty
+from bpy.props import (
+    BoolProperty,
+    CollectionProperty,
+    EnumProperty,
+    FloatProperty,
+    FloatVectorProperty,
+    IntProperty,
+    StringProperty,
+)
 
 from ..addon.errors import DimredError
 from . import room_settings
@@ -171,8 +181,7 @@ class DIMRED_OT_room_click(PanoramaClick, bpy.types.Operator):
         return {'FINISHED'}
 
     def invoke(self, context: bpy.types.Context, event: bpy.types.Event) -> set[str]:
-        space = context.space_data
-        if context.area is None or context.area.type != 'IMAGE_EDITOR' or space.image is None:
+        if not _in_image_editor(context):
             self.report({'ERROR'}, "show the panorama in an Image Editor and start Click Room there")
             return {'CANCELLED'}
         context.window_manager.modal_handler_add(self)
@@ -237,46 +246,108 @@ class DIMRED_OT_object_from_photo(PanoramaClick, bpy.types.Operator):
     bl_idname = "dimred.object_from_photo"
     bl_label = "Object from Photo"
     bl_description = ("Click inside an object standing on the floor in the Image Editor showing the panorama: a box "
-                      "proxy is fitted to its outline (place, width, depth, height, turn) and marked for removal")
+                      "proxy is fitted to its outline (place, width, depth, height, turn; stepped in two heights "
+                      "where one part stands higher, an armchair's back) and marked for removal")
     bl_options = {'REGISTER', 'UNDO'}
 
     name: StringProperty(name="Name", description="The new proxy's name", default="Object")
 
     def execute(self, context: bpy.types.Context) -> set[str]:
-        from ..addon.blender import reader, room_builder
-        from ..addon.roommatch.object_box import box_from_click
+        from ..addon.roommatch.clicks import ObjectClicks
 
-        scene = context.scene
-        try:
-            size = self.size(scene)
-            panorama, probe = reader.panorama_pixels(scene), reader.probe_center(scene)
-            rotation = room_builder.panorama_rotation(scene)
-            box = box_from_click(panorama, (self.x, self.y), click_size=size, probe=probe,
-                                 floor_z=room_builder.floor_height(scene), rotation=rotation,
-                                 inside=room_builder.floor_polygon(scene))
-        except DimredError as error:
-            self.report({'ERROR'}, str(error))
-            return {'CANCELLED'}
-        obj = room_builder.box_object(scene, self.name, box.corners())
-        scene.dimred.mark(obj)
-        room = scene.dimred_room
-        if room.matched and not room.problem:  # the room's picture shows the new box too
-            from ..addon.roommatch.diagnostics import room_picture
-            from ..addon.roommatch.fit import fit_room
-
-            clicks = room.clicks()
-            fitted = fit_room(clicks, rotation=rotation, origin=tuple(probe[:2]), ceiling_height=room.ceiling_height)
-            show_room_picture(room_picture(panorama, fitted, clicks, boxes=(box.corners(),), rotation=rotation))
-        self.report({'INFO'}, _box_line(obj.name, box))
-        return {'FINISHED'}
+        return add_object(self, context, ObjectClicks(self.name, click=(self.x, self.y)))
 
     def invoke(self, context: bpy.types.Context, event: bpy.types.Event) -> set[str]:
-        space = context.space_data
-        if context.area is None or context.area.type != 'IMAGE_EDITOR' or space.image is None:
+        if not _in_image_editor(context):
             self.report({'ERROR'}, "show the panorama in an Image Editor and click the object there")
             return {'CANCELLED'}
         self.take_mouse(context, event)
         return self.execute(context)
+
+
+class DimredContactPoint(bpy.types.PropertyGroup):
+    """One point where an object meets the floor, clicked in the panorama: (column, row) in pixels."""
+
+    point: FloatVectorProperty(name="Point", size=2, description="Column, row in pixels, row 0 at the top")
+
+
+class DIMRED_OT_object_footprint(PanoramaClick, bpy.types.Operator):
+    bl_idname = "dimred.object_footprint"
+    bl_label = "Object from Footprint"
+    bl_description = ("Click where an object meets the floor, in order round it, in the Image Editor showing the "
+                      "panorama; Enter or right click: a prism over those points, its height fitted to the object's "
+                      "outline, is marked for removal; Esc stops")
+    bl_options = {'REGISTER', 'UNDO'}
+
+    name: StringProperty(name="Name", description="The new proxy's name", default="Object")
+    points: CollectionProperty(type=DimredContactPoint, name="Contact Points",
+                               description="Where the object meets the floor (pixels), in order round it")
+
+    def execute(self, context: bpy.types.Context) -> set[str]:
+        from ..addon.roommatch.clicks import ObjectClicks
+
+        footprint = tuple(tuple(p.point) for p in self.points)
+        return add_object(self, context, ObjectClicks(self.name, footprint=footprint))
+
+    def invoke(self, context: bpy.types.Context, event: bpy.types.Event) -> set[str]:
+        if not _in_image_editor(context):
+            self.report({'ERROR'}, "show the panorama in an Image Editor and click the object's feet there")
+            return {'CANCELLED'}
+        self.points.clear()
+        context.window_manager.modal_handler_add(self)
+        context.workspace.status_text_set("Object from Footprint: click where the object meets the floor, in "
+                                          "order round it; Enter/right click: fit; Esc: stop")
+        return {'RUNNING_MODAL'}
+
+    def modal(self, context: bpy.types.Context, event: bpy.types.Event) -> set[str]:
+        if event.type == 'ESC' and event.value == 'PRESS':
+            context.workspace.status_text_set(None)
+            return {'CANCELLED'}
+        if event.type in {'RET', 'NUMPAD_ENTER', 'RIGHTMOUSE'} and event.value == 'PRESS':
+            context.workspace.status_text_set(None)
+            return self.execute(context)
+        if event.type == 'LEFTMOUSE' and event.value == 'PRESS':
+            self.take_mouse(context, event)
+            self.points.add().point = (self.x, self.y)
+            self.report({'INFO'}, f"Contact point {len(self.points) - 1} at ({self.x:.1f}, {self.y:.1f})")
+            return {'RUNNING_MODAL'}
+        return {'PASS_THROUGH'}
+
+
+def add_object(operator: PanoramaClick, context: bpy.types.Context, item) -> set[str]:
+    """Fit the proxy of the object `item` (a click file's object) to the photograph, build it,
+    mark it for removal and draw it into the room's picture; the operator's result."""
+    from ..addon.blender import reader, room_builder
+    from ..addon.roommatch.object_shapes import object_proxy
+
+    scene = context.scene
+    try:
+        size = operator.size(scene)
+        panorama, probe = reader.panorama_pixels(scene), reader.probe_center(scene)
+        rotation = room_builder.panorama_rotation(scene)
+        proxy = object_proxy(panorama, item, click_size=size, probe=probe, floor_z=room_builder.floor_height(scene),
+                             rotation=rotation, inside=room_builder.floor_polygon(scene))
+    except DimredError as error:
+        operator.report({'ERROR'}, str(error))
+        return {'CANCELLED'}
+    obj = room_builder.proxy_object(scene, proxy.solid.mesh(item.name))
+    scene.dimred.mark(obj)
+    room = scene.dimred_room
+    if room.matched and not room.problem:  # the room's picture shows the new proxy too
+        from ..addon.roommatch.diagnostics import room_picture
+        from ..addon.roommatch.fit import fit_room
+
+        clicks = room.clicks()
+        fitted = fit_room(clicks, rotation=rotation, origin=tuple(probe[:2]), ceiling_height=room.ceiling_height)
+        show_room_picture(room_picture(panorama, fitted, clicks, solids=(proxy.solid,), rotation=rotation))
+    width, depth, tall = proxy.size()
+    operator.report({'INFO'}, f"'{obj.name}': {proxy.kind} {width:.2f} × {depth:.2f} × {tall:.2f} m, "
+                              f"{100 * proxy.agreement:.0f} % of the outline agrees")
+    return {'FINISHED'}
+
+
+def _in_image_editor(context: bpy.types.Context) -> bool:
+    return context.area is not None and context.area.type == 'IMAGE_EDITOR' and context.space_data.image is not None
 
 
 class DIMRED_OT_fit_box(bpy.types.Operator):
@@ -446,7 +517,8 @@ def _world_size(scene: bpy.types.Scene) -> tuple[int, int] | None:
         return None
 
 
-classes = (DIMRED_OT_match_room, DIMRED_OT_room_click, DIMRED_OT_room_suggest, DIMRED_OT_object_from_photo,
+classes = (DimredContactPoint, DIMRED_OT_match_room, DIMRED_OT_room_click, DIMRED_OT_room_suggest,
+           DIMRED_OT_object_from_photo, DIMRED_OT_object_footprint,
            DIMRED_OT_fit_box, DIMRED_OT_room_remove_corner, DIMRED_OT_room_clear, DIMRED_OT_room_load_clicks,
            DIMRED_OT_room_save_clicks, DIMRED_OT_show_room_diagnostics)
 

@@ -55,6 +55,7 @@ class DIMRED_PT_room(bpy.types.Panel):
         row.operator("dimred.match_room", text="Snap to Photo", icon='SNAP_ON').snap = True
         row = layout.row(align=True)
         row.operator("dimred.object_from_photo", icon='CUBE')
+        row.operator("dimred.object_footprint", text="", icon='MOD_SOLIDIFY')
         row.operator("dimred.fit_box", icon='FULLSCREEN_ENTER')
         if room.problem:
             layout.label(text=room.problem, icon='ERROR')

@@ -17,6 +17,7 @@ from ..roommatch.fit import DEFAULT_CEILING_HEIGHT, RoomFit, fit_room
 from ..roommatch.meshes import NAMES, MeshData, room_meshes
 from . import reader
 
+_BOX_FACES = ((0, 3, 2, 1), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7))
 #: The scene's custom property holding the last matched room's click file (JSON).
 CLICKS_PROPERTY = "dimred_room_clicks"
 
@@ -113,7 +114,12 @@ def floor_height(scene: bpy.types.Scene) -> float:
 def box_object(scene: bpy.types.Scene, name: str, corners: np.ndarray) -> bpy.types.Object:
     """A new box mesh object `name` (or `name`.001 ...) with the 8 `corners` (bottom four counter-
     clockwise, then the top four), its faces' normals outwards."""
-    obj = bpy.data.objects.new(name, _box_mesh(name, corners))
+    return proxy_object(scene, MeshData(name, np.asarray(corners, dtype=np.float64), _BOX_FACES))
+
+
+def proxy_object(scene: bpy.types.Scene, data: MeshData) -> bpy.types.Object:
+    """A new mesh object named as `data` (or that name.001 ...) of its vertices and faces."""
+    obj = bpy.data.objects.new(data.name, _mesh(data))
     scene.collection.objects.link(obj)
     return obj
 
@@ -121,7 +127,7 @@ def box_object(scene: bpy.types.Scene, name: str, corners: np.ndarray) -> bpy.ty
 def reshape_box(obj: bpy.types.Object, corners: np.ndarray) -> None:
     """Give the box proxy `obj` the world `corners` (as `box_object` takes them): a new mesh with
     the old one's materials, the object's transform cleared to the identity."""
-    mesh = _box_mesh(obj.data.name, corners)
+    mesh = _mesh(MeshData(obj.data.name, np.asarray(corners, dtype=np.float64), _BOX_FACES))
     old = obj.data
     for material in old.materials:
         mesh.materials.append(material)
@@ -132,18 +138,15 @@ def reshape_box(obj: bpy.types.Object, corners: np.ndarray) -> None:
         bpy.data.meshes.remove(old)
 
 
-def _box_mesh(name: str, corners: np.ndarray) -> bpy.types.Mesh:
-    faces = ((0, 3, 2, 1), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7))
-    mesh = bpy.data.meshes.new(name)
-    mesh.from_pydata([tuple(v) for v in np.asarray(corners, dtype=np.float64).tolist()], [], faces)
+def _mesh(data: MeshData) -> bpy.types.Mesh:
+    mesh = bpy.data.meshes.new(data.name)
+    mesh.from_pydata([tuple(v) for v in data.vertices.tolist()], [], [list(f) for f in data.faces])
     mesh.validate()
     return mesh
 
 
 def _put_mesh(scene: bpy.types.Scene, data: MeshData) -> bpy.types.Object:
-    mesh = bpy.data.meshes.new(data.name)
-    mesh.from_pydata([tuple(v) for v in data.vertices.tolist()], [], [list(f) for f in data.faces])
-    mesh.validate()
+    mesh = _mesh(data)
     obj = bpy.data.objects.get(data.name)
     if obj is None:
         obj = bpy.data.objects.new(data.name, mesh)

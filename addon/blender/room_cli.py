@@ -24,12 +24,16 @@ it an empty scene, whose world shows --panorama). Writes into the output folder:
   room_diagnostics.png  the panorama with every edge of the room drawn over it (green floor,
                         magenta ceiling, cyan corners; the clicks in yellow)
 
-With --object-at X Y, also the box proxy of the object clicked there (Object from Photo): its
-width, depth, height and turn fitted to the object's outline, "object" in room.json.
+The click file's objects, and with --object-at X Y the object clicked there, get proxies (Object
+from Photo), marked for removal (the last one as the target), "objects" in room.json: from one
+click a box (width, depth, height and turn fitted to the object's outline), or a box stepped in
+two heights where the outline shows one part higher; from a footprint (the contact points with the
+floor, in order round it) a prism over it, its height fitted to the outline.
 
 A click file: {"width": W, "height": H, "floor": [[x, y], ...], "ceiling": [x, y],
 "camera_height": 1.6 | "known_length": {"kind": "wall", "edge": 0, "metres": 3.2} or
-{"kind": "vertical" | "floor", "from": [x, y], "to": [x, y], "metres": 2.0}, "manhattan": true}.
+{"kind": "vertical" | "floor", "from": [x, y], "to": [x, y], "metres": 2.0}, "manhattan": true,
+"objects": [{"name": "Armchair", "click": [x, y]} | {"name": "Table", "footprint": [[x, y], ...]}]}.
 Pixel coordinates are (column, row) on a W x H panorama, row 0 at the top, whole numbers at pixel
 centres; the floor corners in order round the room. Nothing is written when a click is bad."""
 
@@ -53,7 +57,7 @@ def add_command(commands: argparse._SubParsersAction, *, formatter: type[argpars
                       help="first move the floor corners onto the wall-floor edges the panorama shows near them "
                            "(walls it hides keep their clicks); room.json keeps the clicks as given under snapped")
     room.add_argument("--object-at", nargs=2, type=float, metavar=("X", "Y"),
-                      help="Object from Photo: also fit a box proxy to the object clicked at pixel (X, Y) of the "
+                      help="Object from Photo: also fit a proxy to the object clicked at pixel (X, Y) of the "
                            "click file's panorama, standing on the floor, and mark it for removal")
     room.add_argument("--object-name", default="Object", metavar="NAME", help="that proxy's name (default: Object)")
     room.set_defaults(run=_room, inside_blender=inside_blender)
@@ -68,7 +72,7 @@ def _room(args: argparse.Namespace) -> int:
     from ..roommatch import clicks as click_file
     from ..roommatch.diagnostics import room_picture
     from ..roommatch.fit import DEFAULT_CEILING_HEIGHT, fit_room
-    from ..roommatch.object_box import box_from_click
+    from ..roommatch.object_shapes import object_proxy
     from ..roommatch.photo_edges import edge_offsets
     from ..roommatch.refine import refine_clicks
     from . import reader, room_builder
@@ -110,23 +114,26 @@ def _room(args: argparse.Namespace) -> int:
         scene.dimred_room.load(clicks)
         scene.dimred_room.matched = True
     report.update(room=room.summary(), clicks=clicks.to_dict())
-    boxes: tuple[np.ndarray, ...] = ()
+    objects = clicks.objects
     if args.object_at is not None:
+        objects += (click_file.ObjectClicks(args.object_name, click=tuple(args.object_at)),)
+    solids = []
+    for item in objects:
         if panorama is None:
-            raise DimredError(f"--object-at needs the panorama: {missing}")
-        box = box_from_click(panorama, tuple(args.object_at), click_size=(clicks.width, clicks.height),
-                             probe=room.probe, rotation=rotation, inside=room.corners)
-        obj = room_builder.box_object(scene, args.object_name, box.corners())
+            raise DimredError(f"the object '{item.name}' needs the panorama: {missing}")
+        proxy = object_proxy(panorama, item, click_size=(clicks.width, clicks.height), probe=room.probe,
+                             rotation=rotation, inside=room.corners)
+        obj = room_builder.proxy_object(scene, proxy.solid.mesh(item.name))
         if hasattr(scene, "dimred"):
             scene.dimred.mark(obj)
-        report["object"] = {"name": obj.name, **box.summary()}
-        boxes = (box.corners(),)
+        report.setdefault("objects", []).append({"name": obj.name, **proxy.summary()})
+        solids.append(proxy.solid)
     writers = {}
     if panorama is None:
         report["diagnostics"] = f"no room_diagnostics.png: {missing}"
     else:
         report["photo_edges"] = edge_offsets(panorama, room, rotation=rotation).summary()
-        picture = room_picture(panorama, room, clicks, boxes=boxes, rotation=rotation)
+        picture = room_picture(panorama, room, clicks, solids=tuple(solids), rotation=rotation)
         writers["room_diagnostics.png"] = lambda path: exr.write_png(path, picture)
     writers["room.json"] = outputs.json_writer(report)
     outputs.write_files(args.out, writers, stale=("room_diagnostics.png",))

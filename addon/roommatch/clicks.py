@@ -9,11 +9,15 @@ The click file (`dimred room CLICKS.json`) is a JSON object:
      "known_length": {"kind": "wall", "edge": 0, "metres": 3.2},        ... or one known length:
                      {"kind": "vertical", "from": [x, y], "to": [x, y], "metres": 2.0}  (a door's height)
                      {"kind": "floor", "from": [x, y], "to": [x, y], "metres": 1.2}     (a rug's side)
-     "manhattan": true}                                optional: walls at right angles
+     "manhattan": true,                                optional: walls at right angles
+     "objects": [{"name": "Armchair", "click": [x, y]},                 optional: proxies of objects to remove,
+                 {"name": "Table", "footprint": [[x, y], ...]}]}         from one click inside each, or from
+                                                                        its contact points with the floor
 
 Pixel coordinates are (column, row), row 0 at the top, whole numbers at pixel centres
 (`projection`). A "wall" length is that of the fitted floor's edge from corner `edge` to the
-next; a "vertical" one runs from a floor point straight up to the clicked top.
+next; a "vertical" one runs from a floor point straight up to the clicked top. An object's
+"footprint" is 3 or more points where it meets the floor, in order round it.
 """
 from __future__ import annotations
 
@@ -48,6 +52,24 @@ class KnownLength:
 
 
 @dataclass(frozen=True)
+class ObjectClicks:
+    """An object to make a proxy of: one `click` inside it, or its `footprint`, the points where
+    it meets the floor in order round it."""
+
+    name: str
+    click: Point | None = None
+    footprint: tuple[Point, ...] = ()
+
+    def points(self) -> tuple[Point, ...]:
+        return self.footprint if self.click is None else (self.click,)
+
+    def to_dict(self) -> dict[str, Any]:
+        if self.click is not None:
+            return {"name": self.name, "click": list(self.click)}
+        return {"name": self.name, "footprint": [list(p) for p in self.footprint]}
+
+
+@dataclass(frozen=True)
 class RoomClicks:
     """The clicks of one room in a `width` x `height` panorama, checked on construction."""
 
@@ -58,6 +80,7 @@ class RoomClicks:
     camera_height: float | None = None
     known_length: KnownLength | None = None
     manhattan: bool = False
+    objects: tuple[ObjectClicks, ...] = ()
 
     def __post_init__(self) -> None:
         _check(self)
@@ -69,6 +92,14 @@ class RoomClicks:
     def height_or_default(self) -> float:
         return DEFAULT_CAMERA_HEIGHT if self.camera_height is None else self.camera_height
 
+    def click_count(self) -> int:
+        """How many points were clicked: floor corners, the ceiling point, the known length's
+        ends, and every object's click or contact points (a typed height or length is no click)."""
+        length = self.known_length
+        ends = 0 if length is None or length.kind == "wall" else 2
+        return (len(self.floor) + (self.ceiling is not None) + ends
+                + sum(len(obj.points()) for obj in self.objects))
+
     def to_dict(self) -> dict[str, Any]:
         out: dict[str, Any] = {"width": self.width, "height": self.height, "floor": [list(p) for p in self.floor]}
         if self.ceiling is not None:
@@ -78,6 +109,8 @@ class RoomClicks:
         if self.known_length is not None:
             out["known_length"] = self.known_length.to_dict()
         out["manhattan"] = self.manhattan
+        if self.objects:
+            out["objects"] = [obj.to_dict() for obj in self.objects]
         return out
 
     def to_json(self) -> str:
@@ -88,7 +121,8 @@ def from_dict(data: object) -> RoomClicks:
     """The clicks of a parsed click file; DimredError naming the first thing wrong."""
     if not isinstance(data, dict):
         raise DimredError("the click file must hold a JSON object with width, height and floor")
-    unknown = set(data) - {"width", "height", "floor", "ceiling", "camera_height", "known_length", "manhattan"}
+    unknown = set(data) - {"width", "height", "floor", "ceiling", "camera_height", "known_length", "manhattan",
+                                "objects"}
     if unknown:
         raise DimredError(f"the click file has unknown keys {sorted(unknown)}")
     for key in ("width", "height", "floor"):
@@ -104,6 +138,7 @@ def from_dict(data: object) -> RoomClicks:
         camera_height=None if data.get("camera_height") is None else _number(data["camera_height"], "camera_height"),
         known_length=None if data.get("known_length") is None else _known_length(data["known_length"]),
         manhattan=_boolean(data.get("manhattan", False)),
+        objects=_objects(data.get("objects", [])),
     )
 
 
@@ -130,6 +165,30 @@ def _known_length(data: object) -> KnownLength:
                        end=_point(data["to"], "the known length's end"))
 
 
+def _objects(data: object) -> tuple[ObjectClicks, ...]:
+    if not isinstance(data, list):
+        raise DimredError("'objects' must be a list of objects, each with a name and a click or a footprint")
+    out = []
+    for i, item in enumerate(data):
+        if not isinstance(item, dict) or not isinstance(item.get("name"), str) or not item["name"]:
+            raise DimredError(f"object {i} must be an object with a 'name'")
+        name = item["name"]
+        unknown = set(item) - {"name", "click", "footprint"}
+        if unknown:
+            raise DimredError(f"object '{name}' has unknown keys {sorted(unknown)}")
+        if ("click" in item) == ("footprint" in item):
+            raise DimredError(f"object '{name}' needs a 'click' inside it or a 'footprint', one of them")
+        if "click" in item:
+            out.append(ObjectClicks(name, click=_point(item["click"], f"the click in '{name}'")))
+            continue
+        footprint = item["footprint"]
+        if not isinstance(footprint, list):
+            raise DimredError(f"the footprint of '{name}' must be a list of [x, y] pixel coordinates")
+        out.append(ObjectClicks(name, footprint=tuple(_point(p, f"contact point {j} of '{name}'")
+                                                      for j, p in enumerate(footprint))))
+    return tuple(out)
+
+
 def _check(clicks: RoomClicks) -> None:
     if clicks.width < 2 or clicks.height < 1:
         raise DimredError(f"the panorama size {clicks.width} × {clicks.height} is not a panorama's")
@@ -150,6 +209,12 @@ def _check(clicks: RoomClicks) -> None:
             raise DimredError(f"the known wall {length.edge} is not one of the floor's {len(clicks.floor)} edges")
         if length.kind != "wall":
             named += [(length.start, "the known length's start"), (length.end, "the known length's end")]
+    for obj in clicks.objects:
+        if obj.click is None and len(obj.footprint) < 3:
+            raise DimredError(f"the footprint of '{obj.name}' needs 3 or more contact points, "
+                              f"{len(obj.footprint)} clicked")
+        named += [(p, f"the click in '{obj.name}'" if obj.click is not None else f"contact point {j} of '{obj.name}'")
+                  for j, p in enumerate(obj.points())]
     for (x, y), what in named:
         if not (-0.5 <= x < clicks.width - 0.5 and -0.5 <= y <= clicks.height - 0.5):
             raise DimredError(f"{what} ({x:g}, {y:g}) lies outside the {clicks.width} × {clicks.height} panorama")

@@ -14,6 +14,7 @@ from .clicks import RoomClicks
 from .fit import RoomFit
 from .meshes import room_edges
 from .projection import project
+from .solids import Solid
 
 # Floor, ceiling, wall corner, object box.
 _COLOURS = np.array([[0.1, 1.0, 0.2], [1.0, 0.2, 1.0], [0.0, 1.0, 1.0], [1.0, 0.55, 0.0]], dtype=np.float32)
@@ -24,11 +25,11 @@ _SAMPLES = 4000  # along one edge: under half a pixel apart at 2048 wide
 
 
 def room_picture(panorama: np.ndarray, room: RoomFit, clicks: RoomClicks | None = None, *,
-                 boxes: tuple[np.ndarray, ...] = (), rotation: np.ndarray | None = None,
+                 boxes: tuple[np.ndarray, ...] = (), solids: tuple[Solid, ...] = (), rotation: np.ndarray | None = None,
                  max_width: int = 2048) -> np.ndarray:
     """(h, w, 3) uint8 sRGB picture of `panorama` (H, W, 3) linear RGB, top row first, reduced
-    to at most `max_width` wide, with `room`'s edges, the `boxes` ((8, 3) world corners each)
-    and the `clicks` drawn."""
+    to at most `max_width` wide, with `room`'s edges, the `boxes` ((8, 3) world corners each),
+    the object proxies `solids` and the `clicks` drawn."""
     image = np.asarray(panorama, dtype=np.float32)
     height, width = image.shape[:2]
     if width > max_width:
@@ -36,12 +37,13 @@ def room_picture(panorama: np.ndarray, room: RoomFit, clicks: RoomClicks | None 
         image = resample_axis(resample_axis(image, height, axis=0), width, axis=1)
     picture = _tone_map(image)
     walls = room_edges(room)
-    box_edges = [np.asarray(corners, dtype=np.float64)[_BOX_EDGES] for corners in boxes]
-    edges = np.concatenate([walls, *box_edges]) - room.probe
+    objects = [np.asarray(corners, dtype=np.float64)[_BOX_EDGES] for corners in boxes]
+    objects += [solid.edges() for solid in solids]
+    edges = np.concatenate([walls, *objects]) - room.probe
     t = np.linspace(0.0, 1.0, _SAMPLES)[None, :, None]
     points = edges[:, :1] + t * (edges[:, 1:] - edges[:, :1])
     xy = project(points, width, height, rotation)
-    kind = np.concatenate([np.repeat(np.arange(3), len(walls) // 3), np.full(12 * len(boxes), 3)])
+    kind = np.concatenate([np.repeat(np.arange(3), len(walls) // 3), np.full(len(edges) - len(walls), 3)])
     colour = np.broadcast_to(_COLOURS[kind][:, None, :], (*xy.shape[:2], 3))
     _stamp(picture, xy.reshape(-1, 2), colour.reshape(-1, 3), radius=1)
     if clicks is not None:

@@ -72,13 +72,13 @@ def fit_room(clicks: RoomClicks, *, rotation: np.ndarray | None = None, origin: 
     """
     w, h = clicks.width, clicks.height
     floor = np.asarray(clicks.floor, dtype=np.float64)
-    unit = _unit_floor_points(floor, w, h, rotation, [f"floor corner {i}" for i in range(len(floor))])
-    _check_simple(unit, "the clicked floor polygon")
+    unit = unit_floor_points(floor, w, h, rotation, [f"floor corner {i}" for i in range(len(floor))])
+    check_simple(unit, "the clicked floor polygon")
     turn = None
     if clicks.manhattan:
         snapped = manhattan.snap(unit, floor, w, h, rotation)
         unit, turn = snapped.corners, float(np.degrees(snapped.turn))
-        _check_simple(unit, "the floor polygon snapped to right angles")
+        check_simple(unit, "the floor polygon snapped to right angles")
     if not polygon.contains(unit, np.zeros(2)):
         raise DimredError("the probe centre lies outside the clicked floor polygon: click the corners of the room "
                           "the panorama was taken in, in order round it")
@@ -92,7 +92,7 @@ def fit_room(clicks: RoomClicks, *, rotation: np.ndarray | None = None, origin: 
                    ceiling_from_click=from_click)
 
 
-def _unit_floor_points(points: np.ndarray, width: int, height: int, rotation: np.ndarray | None,
+def unit_floor_points(points: np.ndarray, width: int, height: int, rotation: np.ndarray | None,
                        names: list[str]) -> np.ndarray:
     """(n, 2) floor points at unit camera height seen at the clicks `points` (n, 2)."""
     d = click_directions(points, width, height, rotation)
@@ -105,13 +105,13 @@ def _unit_floor_points(points: np.ndarray, width: int, height: int, rotation: np
     return d[:, :2] / -d[:, 2:3]
 
 
-def _check_simple(unit: np.ndarray, what: str) -> None:
+def check_simple(unit: np.ndarray, what: str, *, hint: str = "click the corners in order round the room") -> None:
+    """DimredError naming two edges of the polygon `unit` (n, 2) that cross, if any."""
     crossing = polygon.crossing_edges(unit)
     if crossing is not None:
         i, j = crossing
         n = len(unit)
-        raise DimredError(f"{what} crosses itself (edge {i}-{(i + 1) % n} meets edge {j}-{(j + 1) % n}): "
-                          "click the corners in order round the room")
+        raise DimredError(f"{what} crosses itself (edge {i}-{(i + 1) % n} meets edge {j}-{(j + 1) % n}): {hint}")
 
 
 def _camera_height(clicks: RoomClicks, unit: np.ndarray, rotation: np.ndarray | None) -> float:
@@ -125,11 +125,11 @@ def _camera_height(clicks: RoomClicks, unit: np.ndarray, rotation: np.ndarray | 
     else:
         ends = np.array([length.start, length.end], dtype=np.float64)
         if length.kind == "floor":
-            q = _unit_floor_points(ends, clicks.width, clicks.height, rotation,
+            q = unit_floor_points(ends, clicks.width, clicks.height, rotation,
                                    ["the known length's start", "the known length's end"])
             unit_length = float(np.linalg.norm(q[1] - q[0]))
         else:
-            foot = _unit_floor_points(ends[:1], clicks.width, clicks.height, rotation, ["the known length's start"])
+            foot = unit_floor_points(ends[:1], clicks.width, clicks.height, rotation, ["the known length's start"])
             top = click_directions(ends[1], clicks.width, clicks.height, rotation)
             # Straight above the foot, at its horizontal distance from the probe.
             unit_length = 1.0 + float(np.linalg.norm(foot)) * top[2] / max(float(np.linalg.norm(top[:2])), 1e-12)

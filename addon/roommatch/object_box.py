@@ -10,6 +10,7 @@ union, the agreement reported).
 """
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -72,19 +73,31 @@ def box_from_click(panorama: np.ndarray, click: tuple[float, float], *, click_si
     """The box proxy of the object clicked at `click` (x, y) on a `click_size` (W, H) panorama,
     its footprint within the floor polygon `inside` ((n, 2) world) where one is given;
     DimredError when the photograph shows no object there standing on the floor."""
+    return box_in_outline(outline_at(panorama, click, click_size=click_size, probe=probe, floor_z=floor_z,
+                                     rotation=rotation, inside=inside), click)
+
+
+def outline_at(panorama: np.ndarray, click: tuple[float, float], *, click_size: tuple[int, int], probe: np.ndarray,
+               floor_z: float = 0.0, rotation: np.ndarray | None = None,
+               inside: np.ndarray | None = None) -> Outline:
+    """The outline of the object seen at `click` (x, y) on a `click_size` (W, H) panorama, segmented
+    from a seed there; DimredError when the photograph sets too little apart."""
     probe, camera = _camera(probe, floor_z)
     view = _View.around(panorama, click, click_size, rotation, _WINDOW)
     band = view.half // 2
     # The segmentation decides a wide band on halved copies first: the seed must survive them.
     halvings = max(0, int(np.ceil(np.log2(band / _COARSEST_BAND))))
     seed = (view.rows[:, None] - view.y) ** 2 + (view.cols[None, :] - view.x) ** 2 <= (_SEED * 2**halvings) ** 2
-    shown = _segment(view.image, seed, band)
-    points = _floor_points(shown, view.directions, camera)
+    return Outline(_segment(view.image, seed, band), view.directions, camera, probe, floor_z, inside)
+
+
+def box_in_outline(outline: Outline, click: tuple[float, float]) -> BoxFit:
+    """The box fitted to `outline`, the object clicked at `click`; DimredError when its foot is not seen."""
+    points = _floor_points(outline.shown, outline.directions, outline.camera)
     if len(points) < 3:
         raise DimredError(f"no object standing on the floor is seen at ({click[0]:g}, {click[1]:g}): click inside "
                           "an object whose foot the panorama shows")
-    start = _first_box(points, shown, view.directions, camera)
-    return _fitted(start, _Outline(shown, view.directions, camera, probe, floor_z, inside))
+    return _fitted(_first_box(points, outline.shown, outline.directions, outline.camera), outline)
 
 
 def refit_box(panorama: np.ndarray, corners: np.ndarray, *, probe: np.ndarray, floor_z: float = 0.0,
@@ -108,7 +121,7 @@ def refit_box(panorama: np.ndarray, corners: np.ndarray, *, probe: np.ndarray, f
     shown = _segment(view.image, proxy, max(2, int(_PROXY_BAND * extent)))
     # From the proxy as modelled, and from the outline's own first box: a turn off by several
     # degrees can hold the search in a nearby optimum.
-    outline = _Outline(shown, view.directions, camera, probe, floor_z, inside)
+    outline = Outline(shown, view.directions, camera, probe, floor_z, inside)
     fits = [_fitted(_front(params), outline)]
     points = _floor_points(shown, view.directions, camera)
     if len(points) >= 3:
@@ -155,10 +168,10 @@ def _camera(probe: np.ndarray, floor_z: float) -> tuple[np.ndarray, float]:
 
 
 @dataclass(frozen=True)
-class _Outline:
-    """What a box is fitted to: the outline (h, w) over a window, its pixels' directions from the
-    probe, the probe's height above the floor, the probe, the floor's z, and the floor polygon
-    ((n, 2) world) the box must stand in, if any."""
+class Outline:
+    """What a proxy is fitted to: the outline (h, w) over a window, its pixels' directions from
+    the probe, the probe's height above the floor, the probe, the floor's z, and the floor
+    polygon ((n, 2) world) the proxy must stand in, if any."""
 
     shown: np.ndarray
     directions: np.ndarray
@@ -167,21 +180,27 @@ class _Outline:
     floor_z: float
     inside: np.ndarray | None
 
+    def cropped(self) -> tuple[np.ndarray, np.ndarray]:
+        """The outline and its directions over its bounding box grown by half its size each way:
+        a proxy whose silhouette reaches past it agrees less anyway."""
+        rows, cols = np.nonzero(self.shown)
+        pad_r, pad_c = (np.ptp(rows) + 1) // 2, (np.ptp(cols) + 1) // 2
+        crop = (slice(max(0, rows.min() - pad_r), rows.max() + pad_r + 1),
+                slice(max(0, cols.min() - pad_c), cols.max() + pad_c + 1))
+        return self.shown[crop], self.directions[crop]
 
-def _fitted(start: np.ndarray, outline: _Outline) -> BoxFit:
-    # The search looks at the outline's bounding box grown by half its size each way: a box
-    # whose silhouette reaches past it agrees less anyway.
-    shown = outline.shown
-    rows, cols = np.nonzero(shown)
-    pad_r, pad_c = (np.ptp(rows) + 1) // 2, (np.ptp(cols) + 1) // 2
-    crop = (slice(max(0, rows.min() - pad_r), rows.max() + pad_r + 1),
-            slice(max(0, cols.min() - pad_c), cols.max() + pad_c + 1))
-    room = None if outline.inside is None else np.asarray(outline.inside, dtype=np.float64) - outline.probe[:2]
-    params, agreement = _search(start, shown[crop], outline.directions[crop], outline.camera, room)
+    def room(self) -> np.ndarray | None:
+        """The floor polygon from the probe, or None."""
+        return None if self.inside is None else np.asarray(self.inside, dtype=np.float64) - self.probe[:2]
+
+
+def _fitted(start: np.ndarray, outline: Outline) -> BoxFit:
+    shown, directions = outline.cropped()
+    params, agreement = _search(start, shown, directions, outline.camera, outline.room())
     probe = outline.probe
     return BoxFit(bottom=np.array([probe[0] + params[0], probe[1] + params[1], outline.floor_z]),
                   size=np.exp(params[2:5]), turn=float(params[5]), agreement=agreement,
-                  outline_pixels=int(shown.sum()))
+                  outline_pixels=int(outline.shown.sum()))
 
 
 def _footprint(centre: np.ndarray, size: np.ndarray, turn: float) -> np.ndarray:
@@ -325,8 +344,7 @@ def _search(params: np.ndarray, shown: np.ndarray, directions: np.ndarray, camer
         if room is not None and not all(contains(room, corner) for corner in
                                         _footprint(centred[:2], np.exp(centred[2:4]), centred[5])):
             return -1.0  # through a wall: never taken
-        box = silhouette(centred, directions, camera)
-        return float(np.count_nonzero(box & shown)) / max(float(np.count_nonzero(box | shown)), 1.0)
+        return agreement(silhouette(centred, directions, camera), shown)
 
     best = score(params)
     for _ in range(_PULLS):  # a first box through a wall is drawn towards the probe, then shrunk
@@ -334,11 +352,25 @@ def _search(params: np.ndarray, shown: np.ndarray, directions: np.ndarray, camer
             break
         params = params * np.array([_PULL, _PULL, 1.0, 1.0, 1.0, 1.0]) - np.array([0, 0, 0, 1 - _PULL, 0, 0])
         best = score(params)
+    params, best = climb(score, params, best, _DIRECTIONS, budget=_MAX_EVALUATIONS)
+    return _centred(params), best
+
+
+def agreement(silhouette: np.ndarray, shown: np.ndarray) -> float:
+    """Pixels a proxy's `silhouette` and the `shown` outline share, over the pixels either covers."""
+    return float(np.count_nonzero(silhouette & shown)) / max(float(np.count_nonzero(silhouette | shown)), 1.0)
+
+
+def climb(score: Callable[[np.ndarray], float], params: np.ndarray, best: float, directions: np.ndarray, *,
+          budget: int) -> tuple[np.ndarray, float]:
+    """Coordinate search from `params` (scoring `best`) for the largest `score`: each move of
+    `directions` tried both ways, the first that gains taken; the moves halved where none gains,
+    down to `_FINEST` of the first, within `budget` evaluations."""
     scale = 1.0
     evaluations = 1
-    while scale > _FINEST and evaluations < _MAX_EVALUATIONS:
+    while scale > _FINEST and evaluations < budget:
         improved = False
-        for direction in _DIRECTIONS:
+        for direction in directions:
             for sign in (1.0, -1.0):
                 trial = params + sign * scale * direction
                 value = score(trial)
@@ -348,4 +380,4 @@ def _search(params: np.ndarray, shown: np.ndarray, directions: np.ndarray, camer
                     break
         if not improved:
             scale /= 2.0
-    return _centred(params), best
+    return params, best

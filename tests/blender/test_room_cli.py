@@ -79,6 +79,34 @@ def test_room_into_the_open_file(files, tmp_path: Path) -> None:
     assert _vertices("Floor")[:, 0].min() == pytest.approx(-4.0, abs=0.08)  # twice the height: twice the room
 
 
+def test_objects_of_the_click_file(tmp_path: Path) -> None:
+    from addon.roommatch.object_box import BoxFit
+    from tests.engine.roommatch.room_truth import with_box
+
+    # Two boxes on the floor: one clicked inside, one by its four feet.
+    chair = np.array([1.8, 0.6, np.log(0.8), np.log(0.7), np.log(0.9), np.radians(20.0)])
+    table = np.array([-1.0, 1.5, np.log(0.6), np.log(0.6), np.log(0.7), 0.0])
+    panorama = tmp_path / "objects.exr"
+    write_exr(panorama, with_box(with_box(flat_panorama(BOX, 2.6, PROBE, 1024, 512), chair, 1.5, (0.7, 0.6, 0.1)),
+                                 table, 1.5, (0.2, 0.3, 0.8)))
+    feet = BoxFit(np.array([-1.0, 1.5, 0.0]), np.array([0.6, 0.6, 0.0]), 0.0, 0.0, 0).corners()[:4]
+    clicks = tmp_path / "clicks.json"
+    clicks.write_text(json.dumps({
+        "width": 1024, "height": 512, "floor": clicks_of(floor_points(BOX), PROBE, 1024, 512).tolist(),
+        "camera_height": 1.5, "objects": [
+            {"name": "Chair", "click": clicks_of(np.array([[1.8, 0.6, 0.45]]), PROBE, 1024, 512)[0].tolist()},
+            {"name": "Table", "footprint": clicks_of(feet, PROBE, 1024, 512).tolist()}]}))
+    saved, out = tmp_path / "room.blend", tmp_path / "out"
+    assert cli.main(["room", "--clicks", str(clicks), "--panorama", str(panorama), "--save", str(saved),
+                     "--out", str(out)]) == 0
+    report = json.loads((out / "room.json").read_text())
+    assert [(o["name"], o["shape"]) for o in report["objects"]] == [("Chair", "box"), ("Table", "footprint prism")]
+    assert all(o["agreement"] >= 0.95 for o in report["objects"])
+    bpy.ops.wm.open_mainfile(filepath=str(saved), load_ui=False)
+    assert _vertices("Chair")[:, 2].max() == pytest.approx(0.9, rel=0.08)
+    assert _vertices("Table")[:, 2].max() == pytest.approx(0.7, rel=0.05)
+
+
 @pytest.mark.parametrize(("change", "expected"), [
     ({"floor": [[10, 200], [20, 200]]}, "a floor needs 3 or more corners, 2 clicked"),
     ({"camera_height": 0}, "the camera height must be above 0 m"),

@@ -154,6 +154,33 @@ def test_object_from_photo_boxes_the_clicked_object(panorama_room: np.ndarray, t
     assert bpy.context.scene.dimred.target.name == "Chair"
 
 
+def test_object_from_footprint_builds_a_prism_of_the_fitted_height(panorama_room: np.ndarray, tmp_path: Path) -> None:
+    from addon.blender import room_builder
+    from addon.roommatch.object_box import BoxFit
+    from tests.engine.roommatch.room_truth import with_box
+
+    chair = np.array([1.8, 0.6, np.log(0.8), np.log(0.7), np.log(0.9), np.radians(20.0)])
+    hdri = tmp_path / "chair.exr"
+    tiny_scene.write_exr(hdri, with_box(flat_panorama(BOX, CEILING, PROBE, 1024, 512), chair, 1.5, (0.7, 0.6, 0.1)))
+    scene = bpy.context.scene
+    room_builder.show_panorama(scene, str(hdri))
+    _click_all(clicks_of(floor_points(BOX), PROBE, 1024, 512))
+    scene.dimred_room.camera_height = 1.5
+    bpy.ops.dimred.match_room()
+    bottom = BoxFit(np.array([1.8, 0.6, 0.0]), np.array([0.8, 0.7, 0.0]), np.radians(20.0), 0.0, 0).corners()[:4]
+    # Where the box meets the floor (an operator's collection argument names each item).
+    feet = [{"name": str(i), "point": tuple(p)} for i, p in enumerate(clicks_of(bottom, PROBE, 1024, 512))]
+    with pytest.raises(RuntimeError, match="a footprint needs 3 or more contact points, 2 clicked"):
+        bpy.ops.dimred.object_footprint(points=feet[:2], name="Chair")
+    assert "Chair" not in bpy.data.objects
+    assert bpy.ops.dimred.object_footprint(points=feet, name="Chair") == {'FINISHED'}
+    corners = _vertices("Chair")
+    assert len(corners) == 8 and corners[:, 2].min() == pytest.approx(0.0, abs=1e-6)
+    assert corners[:, 2].max() == pytest.approx(0.9, rel=0.05)
+    assert corners[:, :2].mean(axis=0) == pytest.approx(chair[:2], abs=0.03)
+    assert scene.dimred.target.name == "Chair"
+
+
 def test_suggest_room_proposes_the_corners(panorama_room: np.ndarray, tmp_path: Path) -> None:
     from addon.blender import room_builder
 

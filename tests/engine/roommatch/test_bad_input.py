@@ -8,7 +8,7 @@ import pytest
 
 from addon.errors import DimredError
 from addon.roommatch import clicks as click_file
-from addon.roommatch.clicks import KnownLength, RoomClicks
+from addon.roommatch.clicks import KnownLength, ObjectClicks, RoomClicks
 from addon.roommatch.fit import fit_room
 from tests.engine.roommatch.room_truth import clicks_of, floor_points
 
@@ -75,6 +75,9 @@ def test_a_ceiling_click_below_the_horizon() -> None:
              "ceiling point .* not above the horizon")
 
 
+_OBJECTS = '{{"width": 8, "height": 4, "floor": [[1, 3], [2, 3], [3, 3]], "objects": [{}]}}'
+
+
 @pytest.mark.parametrize(("text", "match"), [
     ("[1, 2]", "must hold a JSON object"),
     ('{"width": 8, "height": 4}', "no 'floor'"),
@@ -83,6 +86,10 @@ def test_a_ceiling_click_below_the_horizon() -> None:
     (('{"width": 8, "height": 4, "floor": [[1, 3], [2, 3], [3, 3]], "camera_height": 1.6,'
      ' "known_length": {"kind": "wall", "edge": 0, "metres": 3}}'), "not both"),
     ("{", "not valid JSON"),
+    (_OBJECTS.format('{"name": "A", "click": [1, 3], "footprint": [[1, 3], [2, 3], [3, 3]]}'), "one of them"),
+    (_OBJECTS.format('{"name": "A", "footprint": [[1, 3], [2, 3]]}'), "footprint of 'A' needs 3 or more"),
+    (_OBJECTS.format('{"name": "A", "click": [9, 3]}'), r"click in 'A' \(9, 3\) lies outside the 8 × 4"),
+    (_OBJECTS.format('{"click": [1, 3]}'), "object 0 must be an object with a 'name'"),
 ])
 def test_a_bad_click_file(text: str, match: str) -> None:
     _refused(lambda: click_file.from_json(text), match)
@@ -91,5 +98,8 @@ def test_a_bad_click_file(text: str, match: str) -> None:
 def test_the_click_file_round_trips() -> None:
     clicks = RoomClicks(W, H, tuple(FLOOR), ceiling=(10.0, 100.0),
                         known_length=KnownLength("vertical", 2.0, start=(1.0, 300.0), end=(1.0, 200.0)),
-                        manhattan=True)
+                        manhattan=True, objects=(ObjectClicks("Chair", click=(500.0, 350.0)),
+                                                 ObjectClicks("Table", footprint=((1.0, 300.0), (9.0, 300.0),
+                                                                                  (5.0, 320.0)))))
     assert click_file.from_json(json.dumps(clicks.to_dict())) == clicks
+    assert clicks.click_count() == 4 + 1 + 2 + 1 + 3  # corners, ceiling, the length's ends, the objects

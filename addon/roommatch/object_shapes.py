@@ -1,0 +1,193 @@
+"""Object from Photo's proxies: from one click, a box, or a stepped box where the outline shows a
+part standing higher than the rest; from the object's contact points, a prism over them.
+
+One click: the box of `object_box`, then the same box cut in two along its width or its depth,
+each part with its own height and the cut's place searched (an armchair's back behind its seat);
+the stepped box is kept where it agrees with the outline by `_STEP_GAIN` more, so a box stays a
+box. Contact points: clicked where the object meets the floor, in order round it, they give the
+footprint polygon on the floor; the panorama is segmented from a seed above the footprint and the
+prism's height is the one whose silhouette agrees best with the outline.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..errors import DimredError
+from .clicks import ObjectClicks
+from .fit import check_simple, unit_floor_points
+from .object_box import BoxFit, Outline, agreement, box_in_outline, climb, outline_at, silhouette
+from .projection import project
+from .solids import Solid, inside_polygon, prism_silhouette
+
+_STEP_GAIN = 0.01  # the agreement a stepped box must add to the box's to be kept
+# The stepped box's moves: place (m), log width and depth, turn (rad), the cut (logit), log heights.
+_STEP_MOVES = np.diag([0.05, 0.05, 0.1, 0.1, np.radians(5.0), 0.5, 0.1, 0.1])
+_STEP_BUDGET = 300
+_SEED_HEIGHT = 0.25  # metres above the floor where the footprint's seed is
+_HEIGHTS = np.log(np.geomspace(0.05, 4.0, 40))  # the prism heights tried first (log metres)
+_HEIGHT_MOVES = np.array([[0.05]])
+_HEIGHT_BUDGET = 40
+
+
+@dataclass(frozen=True)
+class ObjectProxy:
+    """A proxy fitted to an object's outline: its solid, its kind ("box", "stepped box" or
+    "footprint prism"), how well its silhouette agrees with the outline (shared over united
+    pixels), the outline's pixels, and what the kind adds to the summary."""
+
+    solid: Solid
+    kind: str
+    agreement: float
+    outline_pixels: int
+    details: dict[str, Any]
+
+    def size(self) -> np.ndarray:
+        """The extent (3,) of its vertices along x, y, z in metres."""
+        return np.ptp(self.solid.vertices(), axis=0)
+
+    def summary(self) -> dict[str, Any]:
+        return {"shape": self.kind, **self.details, "agreement": round(self.agreement, 4),
+                "outline_pixels": self.outline_pixels}
+
+
+def object_proxy(panorama: np.ndarray, obj: ObjectClicks, *, click_size: tuple[int, int], probe: np.ndarray,
+                 floor_z: float = 0.0, rotation: np.ndarray | None = None,
+                 inside: np.ndarray | None = None) -> ObjectProxy:
+    """The proxy of a click file's object: from its click or from its footprint."""
+    where = {"click_size": click_size, "probe": probe, "floor_z": floor_z, "rotation": rotation, "inside": inside}
+    if obj.click is not None:
+        return object_from_click(panorama, obj.click, **where)
+    return object_from_footprint(panorama, obj.footprint, **where)
+
+
+def object_from_click(panorama: np.ndarray, click: tuple[float, float], *, click_size: tuple[int, int],
+                      probe: np.ndarray, floor_z: float = 0.0, rotation: np.ndarray | None = None,
+                      inside: np.ndarray | None = None) -> ObjectProxy:
+    """The proxy of the object clicked at `click` (x, y) on a `click_size` (W, H) panorama: its box,
+    or a stepped box where that agrees better with its outline; within the floor polygon `inside`
+    ((n, 2) world) where given. DimredError when the photograph shows no object standing there."""
+    outline = outline_at(panorama, click, click_size=click_size, probe=probe, floor_z=floor_z, rotation=rotation,
+                         inside=inside)
+    box = box_in_outline(outline, click)
+    plain = ObjectProxy(_box_solid(box), "box", box.agreement, box.outline_pixels, box.summary())
+    stepped = max((_stepped(box, outline, axis) for axis in (0, 1)), key=lambda proxy: proxy.agreement)
+    return stepped if stepped.agreement >= box.agreement + _STEP_GAIN else plain
+
+
+def object_from_footprint(panorama: np.ndarray, footprint: tuple[tuple[float, float], ...], *,
+                          click_size: tuple[int, int], probe: np.ndarray, floor_z: float = 0.0,
+                          rotation: np.ndarray | None = None, inside: np.ndarray | None = None) -> ObjectProxy:
+    """The prism over the contact points `footprint` (x, y clicks on a `click_size` (W, H)
+    panorama, in order round the object), its height fitted to the object's outline; DimredError
+    naming the click when they give no footprint on the floor (within `inside`, (n, 2) world)."""
+    width, height = click_size
+    points = np.asarray(footprint, dtype=np.float64).reshape(-1, 2)
+    if len(points) < 3:
+        raise DimredError(f"a footprint needs 3 or more contact points, {len(points)} clicked")
+    names = [f"contact point {i}" for i in range(len(points))]
+    for (x, y), name in zip(points, names, strict=True):
+        if not (-0.5 <= x < width - 0.5 and -0.5 <= y <= height - 0.5):
+            raise DimredError(f"{name} ({x:g}, {y:g}) lies outside the {width} × {height} panorama")
+    probe = np.asarray(probe, dtype=np.float64)
+    camera = float(probe[2] - floor_z)
+    if not camera > 0.0:
+        raise DimredError(f"the probe centre is not above the floor ({camera:.3g} m): match the room first")
+    unit = unit_floor_points(points, width, height, rotation, names)
+    check_simple(unit, "the footprint", hint="click the object's contact points in order round it")
+    corners = unit * camera
+    if inside is not None:
+        room = np.asarray(inside, dtype=np.float64) - probe[:2]
+        outside = np.flatnonzero(~inside_polygon(corners, room))
+        if outside.size:
+            x, y = points[outside[0]]
+            raise DimredError(f"{names[outside[0]]} ({x:g}, {y:g}) lies outside the room's floor")
+    # A point inside the object low above its footprint shows the object, whatever stands on it.
+    seed = np.append(corners.mean(axis=0), _SEED_HEIGHT - camera)
+    at = tuple(project(seed, width, height, rotation))
+    outline = outline_at(panorama, at, click_size=click_size, probe=probe, floor_z=floor_z, rotation=rotation,
+                         inside=inside)
+    shown, directions = outline.cropped()
+
+    def score(log_height: np.ndarray) -> float:
+        return agreement(prism_silhouette(corners, float(np.exp(log_height[0])), directions, camera), shown)
+
+    scores = [score(np.array([h])) for h in _HEIGHTS]
+    start = int(np.argmax(scores))
+    log_height, fitted = climb(score, np.array([_HEIGHTS[start]]), scores[start], _HEIGHT_MOVES, budget=_HEIGHT_BUDGET)
+    tall = float(np.exp(log_height[0]))
+    solid = Solid.prism(corners + probe[:2], floor_z, tall)
+    details = {"footprint_m": np.round(corners + probe[:2], 4).tolist(), "height_m": round(tall, 4)}
+    return ObjectProxy(solid, "footprint prism", fitted, int(outline.shown.sum()), details)
+
+
+def _box_solid(box: BoxFit) -> Solid:
+    return Solid.prism(box.corners()[:4, :2], float(box.bottom[2]), float(box.size[2]))
+
+
+def _stepped(box: BoxFit, outline: Outline, axis: int) -> ObjectProxy:
+    """`box` cut across its width (`axis` 0) or depth (1) into two parts of their own heights,
+    searched with the cut, place, sizes and turn for the best agreement with `outline`."""
+    shown, directions = outline.cropped()
+    room = outline.room()
+    probe = outline.probe
+    start = np.array([box.bottom[0] - probe[0], box.bottom[1] - probe[1], *np.log(box.size[:2]), box.turn, 0.0,
+                      np.log(box.size[2]), np.log(box.size[2])])
+
+    def score(params: np.ndarray) -> float:
+        parts = _parts(params, axis)
+        if room is not None and not all(inside_polygon(_part_footprint(p), room).all() for p in parts):
+            return -1.0  # through a wall: never taken
+        return agreement(np.logical_or.reduce([silhouette(p, directions, outline.camera) for p in parts]), shown)
+
+    params, fitted = climb(score, start, score(start), _STEP_MOVES, budget=_STEP_BUDGET)
+    x, y, log_w, log_d, turn, cut, low, high = params
+    share = _share(cut)
+    details = {"bottom_centre": np.round([probe[0] + x, probe[1] + y, outline.floor_z], 4).tolist(),
+               "size_m": np.round(np.exp([log_w, log_d]), 4).tolist(), "turn_deg": round(float(np.degrees(turn)), 2),
+               "steps_along": ("width", "depth")[axis], "step_share": round(share, 3),
+               "step_heights_m": np.round(np.exp([low, high]), 4).tolist()}
+    return ObjectProxy(_step_solid(params, axis, probe, outline.floor_z), "stepped box", fitted,
+                       int(outline.shown.sum()), details)
+
+
+def _share(cut: float) -> float:
+    return float(1.0 / (1.0 + np.exp(-cut)))
+
+
+def _parts(params: np.ndarray, axis: int) -> list[np.ndarray]:
+    """The two parts of a stepped box as `silhouette`'s box parameters (from the probe)."""
+    x, y, log_w, log_d, turn, cut, low, high = params
+    sides = np.exp([log_w, log_d])
+    along = np.array([np.cos(turn), np.sin(turn)]) if axis == 0 else np.array([-np.sin(turn), np.cos(turn)])
+    share = _share(cut)
+    parts = []
+    for start, stop, log_h in ((0.0, share, low), (share, 1.0, high)):
+        centre = np.array([x, y]) + ((start + stop) / 2.0 - 0.5) * sides[axis] * along
+        size = sides.copy()
+        size[axis] *= stop - start
+        parts.append(np.array([centre[0], centre[1], *np.log(size), log_h, turn]))
+    return parts
+
+
+def _part_footprint(part: np.ndarray) -> np.ndarray:
+    x, y, log_w, log_d, _, turn = part
+    return BoxFit(np.array([x, y, 0.0]), np.exp([log_w, log_d, 0.0]), float(turn), 0.0, 0).corners()[:4, :2]
+
+
+def _step_solid(params: np.ndarray, axis: int, probe: np.ndarray, floor_z: float) -> Solid:
+    """The stepped box as one solid: its side profile (the cut's two heights) swept across it."""
+    x, y, log_w, log_d, turn, cut, low, high = params
+    sides = np.exp([log_w, log_d])
+    width_axis = np.array([np.cos(turn), np.sin(turn), 0.0])
+    depth_axis = np.array([-np.sin(turn), np.cos(turn), 0.0])
+    u = (width_axis, depth_axis)[axis]
+    sweep = np.cross(u, (0.0, 0.0, 1.0))
+    length, across = sides[axis], sides[1 - axis]
+    cut_at = _share(cut) * length
+    h1, h2 = np.exp([low, high])
+    profile = np.array([[0.0, 0.0], [length, 0.0], [length, h2], [cut_at, h2], [cut_at, h1], [0.0, h1]])
+    origin = np.array([probe[0] + x, probe[1] + y, floor_z]) - 0.5 * length * u - 0.5 * across * sweep
+    return Solid(profile, origin, np.stack([u, (0.0, 0.0, 1.0), sweep]), float(across))
