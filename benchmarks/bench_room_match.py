@@ -1,8 +1,9 @@
 """Match Room measured: clicks to the room, Snap to Photo, Suggest Room and Object from Photo on
-the Cycles rooms of known geometry (`scenes.rooms`, rendered once and cached), and the click files
-of the real photographs (tests/data/rooms/):
+the Cycles rooms of known geometry (`scenes.rooms`, rendered once and cached), the click files
+of the real photographs (tests/data/rooms/), and from a click file with objects to a removal that
+runs (the command line, from an empty scene):
     .venv/bin/python benchmarks/bench_room_match.py
-Prints three markdown tables and writes them into docs/results/bench_room_match.md
+Prints four markdown tables and writes them into docs/results/bench_room_match.md
 (`results.write`). The clicks on a render are its true corners projected to pixels and rounded,
 as a user's clicks are; errors are per metre of the corner's distance from the probe (cm/m) or
 relative (%); edge offsets are pixels at 1024x512.
@@ -10,8 +11,10 @@ relative (%); edge offsets are pixels at 1024x512.
 from __future__ import annotations
 
 import dataclasses
+import subprocess
 import sys
 import sysconfig
+import tempfile
 import time
 from pathlib import Path
 
@@ -25,6 +28,7 @@ from addon.roommatch import clicks as click_file
 from addon.roommatch.clicks import KnownLength, RoomClicks
 from addon.roommatch.fit import fit_room
 from addon.roommatch.object_box import box_from_click, silhouette
+from addon.roommatch.object_shapes import object_proxy
 from addon.roommatch.photo_edges import edge_offsets
 from addon.roommatch.projection import project
 from addon.roommatch.refine import refine_clicks
@@ -37,8 +41,6 @@ REPO = Path(__file__).resolve().parents[1]
 PHOTOS = {"apartment": REPO.parent / "shared" / "real_photos" / "apartment.exr",
           "interior": next(Path(sysconfig.get_paths()["purelib"]).glob(
               "bpy/*/datafiles/studiolights/world/interior.exr"), Path("interior.exr"))}
-# The hotel armchair's click (tests/data/rooms/interior.json's panorama).
-ARMCHAIR = (478.0, 345.0)
 
 
 def _worst(errors: np.ndarray) -> str:
@@ -106,12 +108,12 @@ def _rooms() -> tuple[Table, Table]:
 
 def _photos() -> Table:
     table = Table(["photograph", "clicks", "floor edges px (shown >= 90 %)", "ceiling edges px (shown >= 90 %)",
-                   "object from one click", "suggestion"], title="Real photographs, edges at 1024x512")
+                   "objects", "suggestion"], title="Real photographs, edges at 1024x512")
     for name, path in PHOTOS.items():
         if not path.is_file():
             table.row(name, "-", "photograph not on this machine", "", "", "")
             continue
-        clicks = click_file.from_json((REPO / "tests" / "data" / "rooms" / f"{name}.json").read_text())
+        clicks = click_file.from_json(_click_file(name).read_text())
         panorama = read_exr(path)
         room = fit_room(clicks)
         found = edge_offsets(panorama, room)
@@ -120,23 +122,57 @@ def _photos() -> Table:
         def listed(offsets: np.ndarray, shown: np.ndarray) -> str:
             return ", ".join(f"{v:.1f}" for v, s in zip(offsets, shown, strict=True) if s >= 0.9 and np.isfinite(v))
 
-        count = n + (clicks.ceiling is not None)
-        obj = "-"
-        if name == "interior":
-            box = box_from_click(panorama, ARMCHAIR, click_size=(clicks.width, clicks.height), probe=room.probe,
+        proxies = []
+        for item in clicks.objects:
+            proxy = object_proxy(panorama, item, click_size=(clicks.width, clicks.height), probe=room.probe,
                                  inside=room.corners)
-            obj = " x ".join(f"{v:.2f}" for v in box.size) + f" m, agreement {box.agreement:.3f}"
-            count += 1
+            proxies.append(f"{item.name}: {proxy.kind} " + " x ".join(f"{v:.2f}" for v in proxy.size)
+                           + f" m, agreement {proxy.agreement:.3f}")
         suggestion = suggest_room(panorama, width=panorama.shape[1], height=panorama.shape[0])
-        table.row(name, f"{count} + height", listed(found.offsets[:n], found.shown[:n]) or "none",
-                  listed(found.offsets[n:2 * n], found.shown[n:2 * n]) or "none", obj,
+        table.row(name, f"{clicks.click_count()} + height", listed(found.offsets[:n], found.shown[:n]) or "none",
+                  listed(found.offsets[n:2 * n], found.shown[n:2 * n]) or "none", "; ".join(proxies) or "-",
                   "none" if suggestion.clicks is None else f"{len(suggestion.clicks.floor)} corners")
     return table
 
 
+def _end_to_end() -> Table:
+    """From the click file and an empty scene to a removal that runs, through the command line as
+    a user runs it: `dimred room` (the room and the click file's objects), then `dimred remove`."""
+    table = Table(["photograph", "clicks", "room + proxies s", "removal s (draft)", "removal ran"],
+                  title="From an empty scene to a removal: dimred room --clicks, then dimred remove --quality draft")
+    for name, path in PHOTOS.items():
+        clicks_path = _click_file(name)
+        clicks = click_file.from_json(clicks_path.read_text())
+        if not path.is_file() or not clicks.objects:
+            continue
+        with tempfile.TemporaryDirectory() as folder:
+            work = Path(folder)
+            started = time.perf_counter()
+            _cli("room", "--clicks", str(clicks_path), "--panorama", str(path), "--save", str(work / "room.blend"),
+                 "--out", str(work / "room"))
+            room_seconds = time.perf_counter() - started
+            started = time.perf_counter()
+            names = [arg for item in clicks.objects for arg in ("--object", item.name)]
+            _cli("remove", str(work / "room.blend"), *names, "--quality", "draft", "--out", str(work / "removed"))
+            removal_seconds = time.perf_counter() - started
+            ran = (work / "removed" / "edited.exr").is_file()
+        table.row(name, f"{clicks.click_count()} + height ({len(clicks.floor)} floor, "
+                  f"{int(clicks.ceiling is not None)} ceiling, {sum(len(o.points()) for o in clicks.objects)} object)",
+                  f"{room_seconds:.1f}", f"{removal_seconds:.1f}", "yes, edited.exr written" if ran else "no")
+    return table
+
+
+def _cli(*args: str) -> None:
+    subprocess.run([sys.executable, "-m", "addon.cli", *args], cwd=REPO, check=True, capture_output=True)
+
+
+def _click_file(name: str) -> Path:
+    return REPO / "tests" / "data" / "rooms" / f"{name}.json"
+
+
 def main() -> None:
     rooms, objects = _rooms()
-    write(rooms, objects, _photos())
+    write(rooms, objects, _photos(), _end_to_end())
 
 
 if __name__ == "__main__":

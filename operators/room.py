@@ -340,7 +340,7 @@ def add_object(operator: PanoramaClick, context: bpy.types.Context, item) -> set
         clicks = room.clicks()
         fitted = fit_room(clicks, rotation=rotation, origin=tuple(probe[:2]), ceiling_height=room.ceiling_height)
         show_room_picture(room_picture(panorama, fitted, clicks, solids=(proxy.solid,), rotation=rotation))
-    width, depth, tall = proxy.size()
+    width, depth, tall = proxy.size
     operator.report({'INFO'}, f"'{obj.name}': {proxy.kind} {width:.2f} × {depth:.2f} × {tall:.2f} m, "
                               f"{100 * proxy.agreement:.0f} % of the outline agrees")
     return {'FINISHED'}

@@ -35,18 +35,16 @@ _HEIGHT_BUDGET = 40
 @dataclass(frozen=True)
 class ObjectProxy:
     """A proxy fitted to an object's outline: its solid, its kind ("box", "stepped box" or
-    "footprint prism"), how well its silhouette agrees with the outline (shared over united
-    pixels), the outline's pixels, and what the kind adds to the summary."""
+    "footprint prism"), its size (width, depth, height in metres; a footprint's extent along x
+    and y), how well its silhouette agrees with the outline (shared over united pixels), the
+    outline's pixels, and what the kind adds to the summary."""
 
     solid: Solid
     kind: str
+    size: np.ndarray
     agreement: float
     outline_pixels: int
     details: dict[str, Any]
-
-    def size(self) -> np.ndarray:
-        """The extent (3,) of its vertices along x, y, z in metres."""
-        return np.ptp(self.solid.vertices(), axis=0)
 
     def summary(self) -> dict[str, Any]:
         return {"shape": self.kind, **self.details, "agreement": round(self.agreement, 4),
@@ -72,7 +70,7 @@ def object_from_click(panorama: np.ndarray, click: tuple[float, float], *, click
     outline = outline_at(panorama, click, click_size=click_size, probe=probe, floor_z=floor_z, rotation=rotation,
                          inside=inside)
     box = box_in_outline(outline, click)
-    plain = ObjectProxy(_box_solid(box), "box", box.agreement, box.outline_pixels, box.summary())
+    plain = ObjectProxy(_box_solid(box), "box", box.size, box.agreement, box.outline_pixels, box.summary())
     stepped = max((_stepped(box, outline, axis) for axis in (0, 1)), key=lambda proxy: proxy.agreement)
     return stepped if stepped.agreement >= box.agreement + _STEP_GAIN else plain
 
@@ -120,7 +118,8 @@ def object_from_footprint(panorama: np.ndarray, footprint: tuple[tuple[float, fl
     tall = float(np.exp(log_height[0]))
     solid = Solid.prism(corners + probe[:2], floor_z, tall)
     details = {"footprint_m": np.round(corners + probe[:2], 4).tolist(), "height_m": round(tall, 4)}
-    return ObjectProxy(solid, "footprint prism", fitted, int(outline.shown.sum()), details)
+    size = np.append(np.ptp(corners, axis=0), tall)
+    return ObjectProxy(solid, "footprint prism", size, fitted, int(outline.shown.sum()), details)
 
 
 def _box_solid(box: BoxFit) -> Solid:
@@ -144,12 +143,12 @@ def _stepped(box: BoxFit, outline: Outline, axis: int) -> ObjectProxy:
 
     params, fitted = climb(score, start, score(start), _STEP_MOVES, budget=_STEP_BUDGET)
     x, y, log_w, log_d, turn, cut, low, high = params
-    share = _share(cut)
+    size = np.exp([log_w, log_d, max(low, high)])
     details = {"bottom_centre": np.round([probe[0] + x, probe[1] + y, outline.floor_z], 4).tolist(),
-               "size_m": np.round(np.exp([log_w, log_d]), 4).tolist(), "turn_deg": round(float(np.degrees(turn)), 2),
-               "steps_along": ("width", "depth")[axis], "step_share": round(share, 3),
+               "size_m": np.round(size, 4).tolist(), "turn_deg": round(float(np.degrees(turn)), 2),
+               "steps_along": ("width", "depth")[axis], "step_share": round(_share(cut), 3),
                "step_heights_m": np.round(np.exp([low, high]), 4).tolist()}
-    return ObjectProxy(_step_solid(params, axis, probe, outline.floor_z), "stepped box", fitted,
+    return ObjectProxy(_step_solid(params, axis, probe, outline.floor_z), "stepped box", size, fitted,
                        int(outline.shown.sum()), details)
 
 

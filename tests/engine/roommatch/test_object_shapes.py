@@ -37,7 +37,7 @@ def test_a_box_stays_a_box() -> None:
     click = tuple(np.round(project(np.array([1.8, 0.6, 0.45 - 1.5]), W, H)))
     proxy = object_from_click(panorama, click, click_size=(W, H), probe=PROBE, inside=ROOM)
     assert proxy.kind == "box" and proxy.agreement >= 0.95
-    assert proxy.size()[2] == pytest.approx(0.9, rel=0.08)
+    assert proxy.size[2] == pytest.approx(0.9, rel=0.08)
     assert len(proxy.solid.vertices()) == 8
 
 
@@ -56,7 +56,7 @@ def test_a_seat_before_a_higher_back_gets_a_stepped_box() -> None:
     assert proxy.kind == "stepped box" and proxy.agreement >= 0.95
     # A seat seen from above trades its height against its depth: within 15 %.
     assert sorted(proxy.details["step_heights_m"]) == pytest.approx([0.45, 0.95], rel=0.15)
-    assert proxy.size()[2] == pytest.approx(0.95, rel=0.05)
+    assert proxy.size[2] == pytest.approx(0.95, rel=0.05)
 
 
 def test_a_footprint_gives_a_prism_of_the_object_height() -> None:
