@@ -13,8 +13,9 @@ import numpy as np
 
 from . import latlong
 
-_EDGE_SAMPLES = 17
-_BATCH_PIXELS = 1 << 21
+_BATCH_PIXELS = 1 << 20  # pixel tests at a time
+_WIDE = 4096  # a triangle's window of this many pixels is tested alone
+_MARGIN = 1e-3  # pixels a window reaches past a triangle's exact bounds (rounding)
 _PAIR_CHUNK = 40_000
 
 
@@ -33,25 +34,25 @@ class PanoramaHits:
 
 
 def _uv_window(tris: np.ndarray, width: int, height: int) -> tuple[np.ndarray, ...]:
-    """Conservative pixel windows (row0, rows, col0, cols) of triangles seen from the origin."""
-    t = np.linspace(0.0, 1.0, _EDGE_SAMPLES)[None, :, None]
-    edges = [tris[:, k, None, :] * (1.0 - t) + tris[:, (k + 1) % 3, None, :] * t for k in range(3)]
-    pts = np.concatenate(edges, axis=1)
-    u, v = latlong.direction_to_uv(pts)
-    rows = (1.0 - v) * height
-    # An edge passing close to a pole reaches its highest (lowest) elevation between samples,
-    # rows away from the samples' own: take each edge's exact extremes as well.
-    extreme = _edge_extreme_rows(tris, height)
-    row0 = np.clip(np.floor(np.minimum(rows.min(axis=1), extreme.min(axis=1))) - 2, 0, height - 1).astype(np.int64)
-    row1 = np.clip(np.ceil(np.maximum(rows.max(axis=1), extreme.max(axis=1))) + 2, 0, height - 1).astype(np.int64)
-    # The u span is the circle minus its largest gap between samples (handles the seam).
-    u_sorted = np.sort(u, axis=1)
-    gaps = np.diff(np.concatenate([u_sorted, u_sorted[:, :1] + 1.0], axis=1), axis=1)
+    """Pixel windows (row0, rows, col0, cols) holding the centres of every pixel that
+    triangles seen from the origin may cover; rows or cols 0 where they cover none.
+
+    The bounds are exact, widened by `_MARGIN` pixel: an edge seen from the origin is an arc of a
+    great circle, shorter than half of it, along which the elevation has at most one extreme
+    (`_edge_extreme_rows`) and the longitude runs one way, over less than half the circle.
+    So a triangle that holds no pole spans the longitudes between its corners, the circle
+    less the largest gap between them, and a few corners cost what a sliver of a pixel does."""
+    corners = np.arccos(np.clip(tris[..., 2] / np.maximum(np.linalg.norm(tris, axis=2), 1e-300), -1.0, 1.0))
+    rows = np.concatenate([corners / np.pi * height, _edge_extreme_rows(tris, height)], axis=1)
+    # Pixel r's centre lies at r + 0.5 rows (columns) from the top (the seam).
+    row0 = np.maximum(np.ceil(rows.min(axis=1) - 0.5 - _MARGIN), 0).astype(np.int64)
+    row1 = np.minimum(np.floor(rows.max(axis=1) - 0.5 + _MARGIN), height - 1).astype(np.int64)
+    u = np.sort(latlong.direction_to_uv(tris)[0], axis=1)
+    gaps = np.diff(np.concatenate([u, u[:, :1] + 1.0], axis=1), axis=1)
     widest = gaps.argmax(axis=1)
-    start = u_sorted[np.arange(len(u_sorted)), (widest + 1) % u_sorted.shape[1]]
-    span = 1.0 - gaps.max(axis=1)
-    col0 = np.floor(start * width).astype(np.int64) - 2
-    cols = np.ceil(span * width).astype(np.int64) + 5
+    start = u[np.arange(len(u)), (widest + 1) % 3] * width
+    col0 = np.ceil(start - 0.5 - _MARGIN).astype(np.int64)
+    cols = np.floor(start + (1.0 - gaps.max(axis=1)) * width - 0.5 + _MARGIN).astype(np.int64) - col0 + 1
     # A triangle around a pole covers every column near that pole.
     for pole, edge_row in ((np.array([0.0, 0.0, 1.0]), 0), (np.array([0.0, 0.0, -1.0]), height - 1)):
         inside = _inside(tris, pole[None, :])[:, 0]
@@ -59,8 +60,7 @@ def _uv_window(tris: np.ndarray, width: int, height: int) -> tuple[np.ndarray, .
         row1 = np.where(inside & (edge_row == height - 1), height - 1, row1)
         col0 = np.where(inside, 0, col0)
         cols = np.where(inside, width, cols)
-    cols = np.minimum(cols, width)
-    return row0, row1 - row0 + 1, col0, cols
+    return row0, np.maximum(row1 - row0 + 1, 0), np.mod(col0, width), np.clip(cols, 0, width)
 
 
 def _edge_extreme_rows(tris: np.ndarray, height: int) -> np.ndarray:
@@ -96,53 +96,109 @@ def _inside(tris: np.ndarray, dirs: np.ndarray) -> np.ndarray:
     return (np.einsum("tkc,dc->tdk", _edge_normals(tris), dirs) >= 0.0).all(axis=2)
 
 
-def _rasterise(tris, tri_ids, row0, nrows, col0, ncols, dirs, window, best, out) -> None:
-    """Depth-test one batch of triangles that share a window shape into the buffers, which
-    hold the pixels of `window` (first row, first column, panorama width): `dirs` (h, w, 3)."""
+@dataclass(frozen=True)
+class _Windows:
+    """Rectangles of panorama pixels to test against one triangle each, in the order ties of
+    depth go to (the first): `tri` (P,) indexes the triangles, the rest as `_uv_window`'s."""
+
+    tri: np.ndarray
+    row0: np.ndarray
+    rows: np.ndarray
+    col0: np.ndarray
+    cols: np.ndarray
+
+    @property
+    def pixels(self) -> np.ndarray:
+        return self.rows * self.cols
+
+    def split(self, most: int) -> _Windows:
+        """The same pixels in windows of at most `most` (at least a row each), cut into bands
+        of rows, in the same order."""
+        bands = np.maximum(1, most // np.maximum(self.cols, 1))
+        parts = np.maximum(1, -(-self.rows // bands))
+        first = np.repeat(np.cumsum(parts) - parts, parts)
+        k = np.arange(int(parts.sum())) - first
+        of = np.repeat(np.arange(len(parts)), parts)
+        row0 = self.row0[of] + k * bands[of]
+        rows = np.minimum(bands[of], self.row0[of] + self.rows[of] - row0)
+        return _Windows(self.tri[of], row0, rows, self.col0[of], self.cols[of])
+
+    def take(self, sl: slice) -> _Windows:
+        return _Windows(self.tri[sl], self.row0[sl], self.rows[sl], self.col0[sl], self.cols[sl])
+
+    def pairs(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(N,) the window, panorama row and (unwrapped) column of each pixel of each window."""
+        count = self.pixels
+        of = np.repeat(np.arange(len(count)), count)
+        k = np.arange(int(count.sum())) - np.repeat(np.cumsum(count) - count, count)
+        return of, self.row0[of] + k // self.cols[of], self.col0[of] + k % self.cols[of]
+
+
+def _rasterise(planes: tuple[np.ndarray, np.ndarray, np.ndarray], windows: _Windows, dirs: np.ndarray,
+               frame: tuple[int, int, int], best: np.ndarray, out: dict) -> None:
+    """Depth-test the triangles' pixels in `windows` into the buffers, which hold the pixels of
+    a window of the panorama (`frame`: first row, first column, panorama width): `dirs` (h, w, 3).
+    `planes`: the triangles' `_edge_normals`, normals and normals' dot products with a corner."""
     h, w = dirs.shape[:2]
-    win_row, win_col, full_width = window
-    rows = row0[:, None, None] + np.arange(nrows)[None, :, None] - win_row
-    cols = np.mod(col0[:, None, None] + np.arange(ncols)[None, None, :] - win_col, full_width)
-    # Rows past the pole or the window's end were clamped onto its last row, and columns
-    # outside a partial window onto its last column: the clamped duplicates are dropped.
-    in_window = (rows >= 0) & (rows < h) & (cols < w)
-    rows = np.broadcast_to(np.clip(rows, 0, h - 1), (len(tris), nrows, ncols))
-    cols = np.broadcast_to(np.minimum(cols, w - 1), (len(tris), nrows, ncols))
-    rays = dirs[rows, cols]  # (B, nr, nc, 3)
-    edge_normals = _edge_normals(tris)
+    win_row, win_col, full_width = frame
+    of, rows, cols = windows.pairs()
+    rows, cols = rows - win_row, np.mod(cols - win_col, full_width)
+    keep = np.flatnonzero((rows >= 0) & (rows < h) & (cols < w))
+    tri, rows, cols = windows.tri[of[keep]], rows[keep], cols[keep]
+    rays = dirs[rows, cols]  # (N, 3)
+    # One window's triangle is broadcast over its pixels rather than gathered for each.
+    one = len(windows.tri) == 1
+    each = windows.tri[0] if one else tri
     # Unnormalised barycentric weights: each ray's side of the planes through the origin and an edge.
-    weights = np.einsum("bkc,brsc->brsk", edge_normals, rays)
-    inside = (weights >= -1e-12 * np.abs(weights).max(axis=3, keepdims=True)).all(axis=3)
-    normal = np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0])
-    normal_dot_ray = np.einsum("bc,brsc->brs", normal, rays)
-    normal_dot_corner = np.einsum("bc,bc->b", normal, tris[:, 0])
+    edge_normals, normal, offset = planes
+    weights = np.einsum("...kc,...c->...k", edge_normals[each], rays)
+    inside = (weights >= -1e-12 * np.abs(weights).max(axis=1, keepdims=True)).all(axis=1)
     with np.errstate(divide="ignore", invalid="ignore"):
-        dist = normal_dot_corner[:, None, None] / normal_dot_ray
-    ok = inside & (dist > 0.0) & np.isfinite(dist) & in_window
-    tri, row, col = np.nonzero(ok)
-    if len(tri) == 0:
+        dist = offset[each] / np.einsum("...c,...c->...", normal[each], rays)
+    ok = np.flatnonzero(inside & (dist > 0.0) & np.isfinite(dist))
+    if len(ok) == 0:
         return
-    pix = rows[tri, row, col] * w + cols[tri, row, col]
-    depth = dist[tri, row, col]
-    order = np.lexsort((depth, pix))
-    pix, depth, tri, row, col = pix[order], depth[order], tri[order], row[order], col[order]
+    pix, depth, tri, weights = rows[ok] * w + cols[ok], dist[ok], tri[ok], weights[ok]
     first = np.ones(len(pix), dtype=bool)
-    first[1:] = pix[1:] != pix[:-1]
-    pix, depth, tri, row, col = pix[first], depth[first], tri[first], row[first], col[first]
-    closer = depth < best.ravel()[pix]
-    pix, depth, tri, row, col = pix[closer], depth[closer], tri[closer], row[closer], col[closer]
-    bary = weights[tri, row, col]
-    bary = bary / bary.sum(axis=1, keepdims=True)
+    if not one:
+        # The nearest of each pixel's hits, the first triangle's on a tie (a stable sort).
+        order = np.lexsort((depth, pix))
+        pix, depth, tri, weights = pix[order], depth[order], tri[order], weights[order]
+        first[1:] = pix[1:] != pix[:-1]
+    closer = first.copy()
+    closer[first] = depth[first] < best.ravel()[pix[first]]
+    pix, depth, tri, weights = pix[closer], depth[closer], tri[closer], weights[closer]
     best.ravel()[pix] = depth
-    out["tri"].ravel()[pix] = tri_ids[tri]
-    out["bary"].reshape(-1, 2)[pix] = bary[:, 1:]
+    out["tri"].ravel()[pix] = tri
+    out["bary"].reshape(-1, 2)[pix] = (weights / weights.sum(axis=1, keepdims=True))[:, 1:]
+
+
+def _batches(pixels: np.ndarray) -> list[slice]:
+    """Runs of consecutive windows of `pixels` each, at most _BATCH_PIXELS in all (or one
+    window), a window of _WIDE pixels or more alone."""
+    end = np.cumsum(pixels)
+    wide = np.flatnonzero(pixels >= _WIDE)
+    out, i0 = [], 0
+    while i0 < len(end):
+        i1 = int(np.searchsorted(end, (end[i0 - 1] if i0 else 0) + _BATCH_PIXELS, side="right"))
+        next_wide = wide[np.searchsorted(wide, i0):][:1]
+        if len(next_wide):
+            i1 = i0 + 1 if next_wide[0] == i0 else min(i1, int(next_wide[0]))
+        out.append(slice(i0, max(i1, i0 + 1)))
+        i0 = out[-1].stop
+    return out
 
 
 def trace_panorama(triangles: np.ndarray, width: int, height: int, *,
                    window: tuple[int, int, int, int] | None = None) -> PanoramaHits:
     """First hit of each pixel centre's ray from the origin among `triangles` (T, 3, 3), over
     the whole W x H panorama or only its `window` (first row, rows, first column, columns;
-    the columns wrap around the seam): the hits then have the window's shape."""
+    the columns wrap around the seam): the hits then have the window's shape. Where two
+    triangles meet a ray at the same depth, the first of them is hit.
+
+    Each triangle is tested at the pixels of its exact window (`_uv_window`), batches of
+    triangles at once: the cost follows the pixels the triangles cover and their count, so
+    a mesh of many sub-pixel triangles costs about what its outline's pixels do."""
     row_start, nrows_w, col_start, ncols_w = window or (0, height, 0, width)
     dirs = window_directions(width, height, (row_start, nrows_w, col_start, ncols_w))
     best = np.full((nrows_w, ncols_w), np.inf)
@@ -150,29 +206,19 @@ def trace_panorama(triangles: np.ndarray, width: int, height: int, *,
     det = np.einsum("ij,ij->i", triangles[:, 0], np.cross(triangles[:, 1], triangles[:, 2]))
     scale = np.linalg.norm(triangles, axis=2).max(axis=1) ** 3
     seen = np.flatnonzero(np.abs(det) > 1e-12 * scale)  # edge-on triangles cover no pixel centre
-    if len(seen):
-        row0, nrows, col0, ncols = _uv_window(triangles[seen], width, height)
-        # Only the rows inside the window are worth testing.
-        row1 = np.minimum(row0 + nrows, row_start + nrows_w)
-        row0 = np.maximum(row0, row_start)
-        inside = row1 > row0
-        seen, row0, nrows, col0, ncols = seen[inside], row0[inside], (row1 - row0)[inside], col0[inside], ncols[inside]
-        size = np.maximum(nrows, ncols)
-        bucket = np.maximum(2, np.ceil(np.log2(np.maximum(size, 1)))).astype(int)
-        frame = (row_start, col_start, width)
-        for k in np.unique(bucket):
-            members = np.flatnonzero(bucket == k)
-            if k <= 6:
-                side = 1 << k
-                per = max(1, _BATCH_PIXELS // (side * side))
-                for i0 in range(0, len(members), per):
-                    m = members[i0 : i0 + per]
-                    _rasterise(triangles[seen[m]], seen[m], row0[m], side, col0[m], side, dirs, frame, best, out)
-            else:
-                for m in members:
-                    sl = slice(m, m + 1)
-                    _rasterise(triangles[seen[sl]], seen[sl], row0[sl], int(nrows[m]), col0[sl], int(ncols[m]),
-                               dirs, frame, best, out)
+    row0, nrows, col0, ncols = _uv_window(triangles[seen], width, height)
+    # Only the rows inside the window are worth testing.
+    row1 = np.minimum(row0 + nrows, row_start + nrows_w)
+    row0 = np.maximum(row0, row_start)
+    some = np.flatnonzero((row1 > row0) & (ncols > 0))
+    windows = _Windows(seen[some], row0[some], (row1 - row0)[some], col0[some], ncols[some]).split(_BATCH_PIXELS)
+    normal = np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0])
+    edge_normals = np.zeros((len(triangles), 3, 3))
+    edge_normals[seen] = _edge_normals(triangles[seen])
+    planes = (edge_normals, normal, np.einsum("tc,tc->t", normal, triangles[:, 0]))
+    for batch in _batches(windows.pixels):
+        # In the triangles' order: the earlier batch keeps a tie of depth.
+        _rasterise(planes, windows.take(batch), dirs, (row_start, col_start, width), best, out)
     distance = np.where(np.isfinite(best), best, 0.0)
     return PanoramaHits(tri=out["tri"], distance=distance, bary=out["bary"], directions=dirs)
 

@@ -39,6 +39,26 @@ def test_an_edge_passing_close_to_a_pole_still_covers_the_rows_beside_it(offset)
         assert (hits.tri >= 0).all(), f"{(hits.tri < 0).sum()} pixels missed at {width}"
 
 
+def test_a_box_split_into_many_sub_pixel_triangles_is_seen_as_the_box():
+    from addon.geometry.patches import split_triangles
+
+    obj = box([-1.4, -0.3, -1.2], [-0.8, 0.3, -0.4])  # across the seam
+    fine = split_triangles(obj, 24).reshape(-1, 3, 3)  # 6912 triangles, most smaller than a pixel
+    coarse = trace_panorama(np.concatenate([ROOM, obj]), 256, 128)
+    split = trace_panorama(np.concatenate([ROOM, fine]), 256, 128)
+    np.testing.assert_array_equal(coarse.tri >= 12, split.tri >= 12)
+    np.testing.assert_allclose(split.distance, coarse.distance, rtol=1e-9)
+    window = trace_panorama(fine, 256, 128, window=(60, 40, 240, 32))
+    inside = split.tri[60:100, np.r_[240:256, 0:16]]
+    np.testing.assert_array_equal(window.tri, np.where(inside >= 12, inside - 12, -1))
+    assert (window.tri >= 0).any() and (window.tri < 0).any()
+
+
+def test_a_ray_meeting_two_triangles_at_the_same_depth_hits_the_first():
+    hits = trace_panorama(np.concatenate([ROOM[:1], ROOM]), 64, 32)
+    assert (hits.tri != 1).all() and (hits.tri == 0).any()
+
+
 def test_first_hits_and_crossings_of_a_unit_cube():
     from addon.geometry.raycast import crossings, first_hits
 
