@@ -24,13 +24,16 @@ the same preset (and working width) in the same run; --working-widths repeats ea
 rows with the light solved at those widths (`--working-width`), default the preset's own.
 The targets are 8K within 4x the 1K time and 3 GB, 16K within 8 GB, 49k triangles within 2x
 the 12-triangle time and memory. Timings on a shared machine are noisy: compare the rows of
-one run. The table is printed and written into docs/results/bench_scale.md.
+one run. Under the table, the floor the largest panorama's rows compare against: what reading
+its EXR, one numpy pass over its pixels and writing it once cost in this process. The table is
+printed and written into docs/results/bench_scale.md.
 """
 from __future__ import annotations
 
 import argparse
 import json
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -42,6 +45,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from addon.io import exr
 from rendered import arguments
 from results import Table, write
 from scenes import metrics
@@ -93,10 +97,19 @@ def _cases(args: argparse.Namespace) -> list[Case]:
         factor = width // source
         folder = CACHE / spec.key() / f"x{factor}-k{split}"
         case = Case(width, split, factor, render_pair(spec), folder)
-        if not (folder / "case.json").exists():
+        if not _built(folder):
             _setup(case, spec.remove)
         cases.append(case)
     return cases
+
+
+def _built(folder: Path) -> bool:
+    """Whether the case in `folder` is built and its panorama is where its files say (a case
+    copied from another checkout, or built before paths were kept relative, is built again)."""
+    if not (folder / "case.json").exists():
+        return False
+    hdri = json.loads((folder / "case.json").read_text()).get("hdri")
+    return hdri is not None and (folder / hdri).is_file()
 
 
 def _setup(case: Case, name: str) -> None:
@@ -129,11 +142,15 @@ def _build(args: argparse.Namespace) -> None:
     if args.split > 1:
         _split_mesh(bpy.data.objects[args.object], args.split)
     bpy.ops.wm.save_as_mainfile(filepath=str(args.setup / "scene.blend"))
+    # Paths relative to the case, so that the cache stays valid wherever the checkout is.
+    bpy.ops.file.make_paths_relative()
+    bpy.ops.wm.save_mainfile()
     data = reader.read_scene(scene, defer_file=True)
+    hdri = os.path.relpath(data.hdri_path, args.setup)
     np.savez(args.setup / "geometry.npz", rotation=data.rotation, center=data.center, triangles=data.triangles,
-             tri_object=data.tri_object, object_names=np.array(data.object_names), hdri_path=data.hdri_path)
+             tri_object=data.tri_object, object_names=np.array(data.object_names), hdri_path=hdri)
     triangles = int((data.tri_object == data.object_index(args.object)).sum())
-    (args.setup / "case.json").write_text(json.dumps({"triangles": triangles}))
+    (args.setup / "case.json").write_text(json.dumps({"triangles": triangles, "hdri": hdri}))
 
 
 def _split_mesh(obj, k: int) -> None:
@@ -172,7 +189,8 @@ def _engine(args: argparse.Namespace) -> None:
     data = np.load(args.engine_child / "geometry.npz")
     scene = loaded(SceneData(hdri=None, rotation=data["rotation"], center=data["center"],
                              triangles=data["triangles"], tri_object=data["tri_object"],
-                             object_names=[str(n) for n in data["object_names"]], hdri_path=str(data["hdri_path"])))
+                             object_names=[str(n) for n in data["object_names"]],
+                             hdri_path=str(args.engine_child / str(data["hdri_path"]))))
     overrides = {} if args.working_width is None else {"working_width": args.working_width}
     result = remove_object(scene, args.object, quality=args.quality, **overrides)
     args.out.mkdir(parents=True, exist_ok=True)
@@ -227,11 +245,42 @@ def _cells(preset: Preset, engine: bool, case: Case, run: Measured, base: Measur
         tail = (run.out.parent / "log.txt").read_text().strip().splitlines() or ["no output"]
         return [*head, str(triangles), f"failed ({run.status}): {tail[-1]}", "", "", "", "", ""]
     stages = json.loads((run.out / "report.json").read_text())["seconds"]
+    if not engine:
+        # The report is written with the results, so its seconds end before they do: the
+        # writing is the command's own total ("removed ... in T s") less the report's.
+        said = re.search(r" in ([0-9.]+) s; wrote", (run.out.parent / "log.txt").read_text())
+        if said:
+            stages["write"] = float(said.group(1)) - stages["total"]
     slowest = sorted(((v, k) for k, v in stages.items() if k not in ("total", "read_scene")), reverse=True)[:3]
     ok = not base.status
     return [*head, str(triangles), f"{run.seconds:.1f}", f"{run.seconds / base.seconds:.2f}" if ok else "",
             f"{run.peak_gb:.2f}", f"{run.peak_gb / base.peak_gb:.2f}" if ok else "", _error(case, run, engine),
             ", ".join(f"{k} {v:.1f}" for v, k in slowest)]
+
+
+def _floor(case: Case) -> str:
+    """What one pass over the pixels of `case`'s panorama costs here, in this process: reading
+    its EXR, one numpy pass (the edited panorama's sum of two images) and writing it as the
+    command line writes its results (the engine's reader and writer)."""
+    hdri = json.loads((case.folder / "case.json").read_text())["hdri"]
+    started = time.perf_counter()
+    image = exr.read_exr(case.folder / hdri)
+    read = time.perf_counter() - started
+    started = time.perf_counter()
+    out = image + image
+    add = time.perf_counter() - started
+    started = time.perf_counter()
+    np.add(image, image, out=out)
+    again = time.perf_counter() - started
+    with tempfile.TemporaryDirectory() as folder:
+        started = time.perf_counter()
+        exr.write_exr(Path(folder) / "pass.exr", out)
+        written = time.perf_counter() - started
+    pixels = image.shape[0] * image.shape[1]
+    return (f"one pass over the {image.shape[1]}x{image.shape[0]} panorama ({pixels / 1e6:.1f} M float32 RGB pixels) "
+            f"here: reading its EXR {read:.2f} s; a numpy sum of two such images {add:.2f} s into a new array, "
+            f"{again:.2f} s into the same one again (this machine is slow to hand a process memory it has not "
+            f"touched yet); writing one EXR {written:.2f} s")
 
 
 def _ints(text: str) -> list[int]:
@@ -284,7 +333,7 @@ def main() -> None:
                                  "resident set")
     for row in rows:
         table.row(*row)
-    write(table)
+    write(table, notes=[f"The floor to compare against: {_floor(max(cases, key=lambda c: c.width))}."])
 
 
 if __name__ == "__main__":
