@@ -39,8 +39,33 @@ from tests.engine.roommatch.room_truth import clicks_of, distance_errors, floor_
 
 REPO = Path(__file__).resolve().parents[1]
 PHOTOS = {"apartment": REPO.parent / "shared" / "real_photos" / "apartment.exr",
+          "lobby": REPO.parent / "shared" / "real_photos" / "lobby.exr",
           "interior": next(Path(sysconfig.get_paths()["purelib"]).glob(
               "bpy/*/datafiles/studiolights/world/interior.exr"), Path("interior.exr"))}
+
+# What the photographs' figures are, and what they are not (looked at on the pictures).
+NOTES = (
+    ("An edge's offset is the median distance from the strongest change of log-luminance within 6 px across "
+     "its reprojection; furniture in front of a wall's foot is an edge too, so an edge counts as shown, not "
+     "as clear. The edges clear on the photographs (tests/engine/roommatch/test_real_photos.py) lie within "
+     "2 px; the others are named here."),
+    ("apartment: edge 0, the window wall: the French door's bottom frame lies 2.5-3 px above the floor's edge "
+     "and a dark band below it; the offsets split between the two, the clicks lie between them: the measure "
+     "cannot tell which is the floor's, and a half pixel of the 512x256 photograph is 1 px here. The pillar "
+     "shows two faces at its foot (edges 3 and 4, a corner clicked between them)."),
+    ("lobby: corners where the walls' feet, traced column by column, cross; the far wall (edge 1) is clear, "
+     "the green wall's foot (edge 3) is behind benches, the wall left of the far one (edge 0) is no one "
+     "plane (a recessed corridor), the stairs' side (edge 2) is their lowest step's edge."),
+    "interior (the hotel room): every floor edge is behind the bed, desk, armchair or curtains.",
+    ("warehouse: no click file. Its floor meets the walls 10-30 m away, 2-7 degrees below the horizon, where "
+     "one pixel of the 512x256 photograph moves a wall by 1.5-3 m; the walls traced column by column come "
+     "out neither straight nor at right angles."),
+    ("workshop: no click file. Benches, stands, partitions and machines stand along every wall: the "
+     "photograph shows no floor corner and no stretch of a wall's foot."),
+    ("The hotel armchair from one click: the outline stops at the seat's skirt (its dark legs are not in "
+     "it), so the proxy's front stands behind the front legs; the arms' curves and the back's slope are no "
+     "box's, stepped or not."),
+)
 
 
 def _worst(errors: np.ndarray) -> str:
@@ -107,11 +132,12 @@ def _rooms() -> tuple[Table, Table]:
 
 
 def _photos() -> Table:
-    table = Table(["photograph", "clicks", "floor edges px (shown >= 90 %)", "ceiling edges px (shown >= 90 %)",
-                   "objects", "suggestion"], title="Real photographs, edges at 1024x512")
+    table = Table(["photograph", "native size", "clicks", "floor edges px (edge: offset, shown >= 90 %)",
+                   "ceiling edges px (shown >= 90 %)", "objects", "suggestion"],
+                  title="Real photographs, edges at 1024x512 (a 512x256 photograph upsampled: a pixel of it is 2)")
     for name, path in PHOTOS.items():
         if not path.is_file():
-            table.row(name, "-", "photograph not on this machine", "", "", "")
+            table.row(name, "-", "-", "photograph not on this machine", "", "", "")
             continue
         clicks = click_file.from_json(_click_file(name).read_text())
         panorama = read_exr(path)
@@ -120,17 +146,23 @@ def _photos() -> Table:
         n = len(clicks.floor)
 
         def listed(offsets: np.ndarray, shown: np.ndarray) -> str:
-            return ", ".join(f"{v:.1f}" for v, s in zip(offsets, shown, strict=True) if s >= 0.9 and np.isfinite(v))
+            return ", ".join(f"{i}: {v:.1f}" for i, (v, s) in enumerate(zip(offsets, shown, strict=True))
+                             if s >= 0.9 and np.isfinite(v))
 
         proxies = []
         for item in clicks.objects:
             proxy = object_proxy(panorama, item, click_size=(clicks.width, clicks.height), probe=room.probe,
                                  inside=room.corners)
+            alone = proxy.details.get("box_agreement")
             proxies.append(f"{item.name}: {proxy.kind} " + " x ".join(f"{v:.2f}" for v in proxy.size)
-                           + f" m, agreement {proxy.agreement:.3f}")
+                           + f" m, agreement {proxy.agreement:.3f}"
+                           + ("" if alone is None else f" (the box alone {alone:.3f})"))
         suggestion = suggest_room(panorama, width=panorama.shape[1], height=panorama.shape[0])
-        table.row(name, f"{clicks.click_count()} + height", listed(found.offsets[:n], found.shown[:n]) or "none",
-                  listed(found.offsets[n:2 * n], found.shown[n:2 * n]) or "none", "; ".join(proxies) or "-",
+        table.row(name, f"{panorama.shape[1]}x{panorama.shape[0]}", f"{clicks.click_count()} + height",
+                  listed(found.offsets[:n], found.shown[:n]) or "none",
+                  (listed(found.offsets[n:2 * n], found.shown[n:2 * n]) or "none") if clicks.ceiling is not None
+                  else "no ceiling click",
+                  "; ".join(proxies) or "-",
                   "none" if suggestion.clicks is None else f"{len(suggestion.clicks.floor)} corners")
     return table
 
@@ -172,7 +204,7 @@ def _click_file(name: str) -> Path:
 
 def main() -> None:
     rooms, objects = _rooms()
-    write(rooms, objects, _photos(), _end_to_end())
+    write(rooms, objects, _photos(), _end_to_end(), notes=NOTES)
 
 
 if __name__ == "__main__":

@@ -1,6 +1,7 @@
 """Match Room: click the room's floor corners in the panorama, then build Floor, Walls and Ceiling.
 
-`dimred.room_click` adds clicks: interactively in an Image Editor showing the panorama (left
+`dimred.room_click` adds clicks: interactively in an Image Editor showing the panorama, or in a
+3D viewport showing the world (`dimred.look_from_probe`: through a camera at the probe centre) (left
 click a floor corner, Ctrl+click the wall-ceiling point, Shift+click the known length's ends,
 Alt+click to move the nearest corner, Enter or right click to match, Esc to stop), or from a
 script with `kind`, `x` and `y`.
@@ -126,7 +127,7 @@ class DIMRED_OT_match_room(bpy.types.Operator):
 
 class PanoramaClick:
     """A click's place in the panorama, for scripts (x, y on a width x height panorama) or taken
-    from the mouse in the Image Editor showing it."""
+    from the mouse in the Image Editor showing it or in a 3D viewport showing the world."""
 
     x: FloatProperty(name="Column", description="Pixels from the left, pixel centres at whole numbers")
     y: FloatProperty(name="Row", description="Pixels from the top, pixel centres at whole numbers")
@@ -141,8 +142,19 @@ class PanoramaClick:
         return size
 
     def take_mouse(self, context: bpy.types.Context, event: bpy.types.Event) -> None:
+        mouse = (event.mouse_region_x, event.mouse_region_y)
+        if context.area.type == 'VIEW_3D':
+            # The viewport shows the world behind everything along the view ray: its direction
+            # is the panorama's pixel, wherever the view stands.
+            from bpy_extras import view3d_utils
+
+            from ..addon.blender import room_builder
+
+            direction = view3d_utils.region_2d_to_vector_3d(context.region, context.region_data, mouse)
+            self.x, self.y, self.width, self.height = room_builder.panorama_pixel(context.scene, direction)
+            return
         image = context.space_data.image
-        u, v = context.region.view2d.region_to_view(event.mouse_region_x, event.mouse_region_y)
+        u, v = context.region.view2d.region_to_view(*mouse)
         self.width, self.height = image.size
         self.x, self.y = u * self.width - 0.5, (1.0 - v) * self.height - 0.5
 
@@ -151,6 +163,7 @@ class DIMRED_OT_room_click(PanoramaClick, bpy.types.Operator):
     bl_idname = "dimred.room_click"
     bl_label = "Click Room"
     bl_description = ("Click the floor's corners in order round the room in the Image Editor showing the panorama "
+                      "or in the 3D viewport looking from the probe "
                       "(Ctrl: the wall-ceiling point, Shift: the known length's ends, Alt: move the nearest corner "
                       "here); Enter or right click matches the room, Esc stops")
     bl_options = {'REGISTER', 'UNDO'}
@@ -181,8 +194,8 @@ class DIMRED_OT_room_click(PanoramaClick, bpy.types.Operator):
         return {'FINISHED'}
 
     def invoke(self, context: bpy.types.Context, event: bpy.types.Event) -> set[str]:
-        if not _in_image_editor(context):
-            self.report({'ERROR'}, "show the panorama in an Image Editor and start Click Room there")
+        if not _in_panorama_view(context):
+            self.report({'ERROR'}, f"start Click Room {_WHERE}")
             return {'CANCELLED'}
         context.window_manager.modal_handler_add(self)
         context.workspace.status_text_set("Click Room: click floor corners in order; Ctrl: ceiling point; "
@@ -245,7 +258,8 @@ class DIMRED_OT_room_suggest(bpy.types.Operator):
 class DIMRED_OT_object_from_photo(PanoramaClick, bpy.types.Operator):
     bl_idname = "dimred.object_from_photo"
     bl_label = "Object from Photo"
-    bl_description = ("Click inside an object standing on the floor in the Image Editor showing the panorama: a box "
+    bl_description = ("Click inside an object standing on the floor in the Image Editor showing the panorama (or "
+                      "the 3D viewport looking from the probe): a box "
                       "proxy is fitted to its outline (place, width, depth, height, turn; stepped in two heights "
                       "where one part stands higher, an armchair's back) and marked for removal")
     bl_options = {'REGISTER', 'UNDO'}
@@ -258,8 +272,8 @@ class DIMRED_OT_object_from_photo(PanoramaClick, bpy.types.Operator):
         return add_object(self, context, ObjectClicks(self.name, click=(self.x, self.y)))
 
     def invoke(self, context: bpy.types.Context, event: bpy.types.Event) -> set[str]:
-        if not _in_image_editor(context):
-            self.report({'ERROR'}, "show the panorama in an Image Editor and click the object there")
+        if not _in_panorama_view(context):
+            self.report({'ERROR'}, f"click the object {_WHERE}")
             return {'CANCELLED'}
         self.take_mouse(context, event)
         return self.execute(context)
@@ -275,8 +289,8 @@ class DIMRED_OT_object_footprint(PanoramaClick, bpy.types.Operator):
     bl_idname = "dimred.object_footprint"
     bl_label = "Object from Footprint"
     bl_description = ("Click where an object meets the floor, in order round it, in the Image Editor showing the "
-                      "panorama; Enter or right click: a prism over those points, its height fitted to the object's "
-                      "outline, is marked for removal; Esc stops")
+                      "panorama (or the 3D viewport looking from the probe); Enter or right click: a prism over "
+                      "those points, its height fitted to the object's outline, is marked for removal; Esc stops")
     bl_options = {'REGISTER', 'UNDO'}
 
     name: StringProperty(name="Name", description="The new proxy's name", default="Object")
@@ -290,8 +304,8 @@ class DIMRED_OT_object_footprint(PanoramaClick, bpy.types.Operator):
         return add_object(self, context, ObjectClicks(self.name, footprint=footprint))
 
     def invoke(self, context: bpy.types.Context, event: bpy.types.Event) -> set[str]:
-        if not _in_image_editor(context):
-            self.report({'ERROR'}, "show the panorama in an Image Editor and click the object's feet there")
+        if not _in_panorama_view(context):
+            self.report({'ERROR'}, f"click the object's feet {_WHERE}")
             return {'CANCELLED'}
         self.points.clear()
         context.window_manager.modal_handler_add(self)
@@ -346,8 +360,18 @@ def add_object(operator: PanoramaClick, context: bpy.types.Context, item) -> set
     return {'FINISHED'}
 
 
-def _in_image_editor(context: bpy.types.Context) -> bool:
-    return context.area is not None and context.area.type == 'IMAGE_EDITOR' and context.space_data.image is not None
+def _in_panorama_view(context: bpy.types.Context) -> bool:
+    """Whether the mouse is over the panorama: an Image Editor showing it, or a 3D viewport (the
+    world behind the scene; Look from Probe shows it from the probe centre)."""
+    area = context.area
+    if area is None:
+        return False
+    if area.type == 'VIEW_3D':
+        return context.region_data is not None
+    return area.type == 'IMAGE_EDITOR' and context.space_data.image is not None
+
+
+_WHERE = "in an Image Editor showing the panorama or in a 3D viewport (Look from Probe)"
 
 
 class DIMRED_OT_fit_box(bpy.types.Operator):
@@ -486,6 +510,38 @@ class DIMRED_OT_room_save_clicks(bpy.types.Operator):
         return {'FINISHED'}
 
 
+class DIMRED_OT_look_from_probe(bpy.types.Operator):
+    bl_idname = "dimred.look_from_probe"
+    bl_label = "Look from Probe"
+    bl_description = ("Look at the panorama from the probe centre in the 3D viewport: the camera 'Probe Camera' "
+                      "there, the world shown behind the room's meshes (drawn as wires); Click Room, Object from "
+                      "Photo and Object from Footprint then take their clicks in the viewport")
+    bl_options = {'REGISTER', 'UNDO'}
+
+    def execute(self, context: bpy.types.Context) -> set[str]:
+        from ..addon.blender import room_builder
+        from ..addon.roommatch.meshes import NAMES
+
+        scene = context.scene
+        camera = room_builder.probe_camera(scene)
+        for name in NAMES:
+            obj = scene.objects.get(name)
+            if obj is not None:
+                obj.display_type = 'WIRE'
+        views = [area for area in (context.screen.areas if context.screen else ()) if area.type == 'VIEW_3D']
+        if context.area is not None and context.area.type == 'VIEW_3D':
+            views = [context.area]
+        for area in views[:1]:
+            space = area.spaces.active
+            space.region_3d.view_perspective = 'CAMERA'
+            space.shading.type = 'MATERIAL'
+            space.shading.use_scene_world = True
+            space.lock_camera = True  # turning the view turns the camera
+        where = "in the 3D viewport" if views else "(no 3D viewport open: look through it there)"
+        self.report({'INFO'}, f"Looking through '{camera.name}' at the probe centre {where}")
+        return {'FINISHED'}
+
+
 class DIMRED_OT_show_room_diagnostics(bpy.types.Operator):
     bl_idname = "dimred.show_room_diagnostics"
     bl_label = "Show Room Diagnostics"
@@ -520,6 +576,6 @@ def _world_size(scene: bpy.types.Scene) -> tuple[int, int] | None:
 classes = (DimredContactPoint, DIMRED_OT_match_room, DIMRED_OT_room_click, DIMRED_OT_room_suggest,
            DIMRED_OT_object_from_photo, DIMRED_OT_object_footprint,
            DIMRED_OT_fit_box, DIMRED_OT_room_remove_corner, DIMRED_OT_room_clear, DIMRED_OT_room_load_clicks,
-           DIMRED_OT_room_save_clicks, DIMRED_OT_show_room_diagnostics)
+           DIMRED_OT_room_save_clicks, DIMRED_OT_look_from_probe, DIMRED_OT_show_room_diagnostics)
 
 register, unregister = bpy.utils.register_classes_factory(classes)

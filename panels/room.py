@@ -22,6 +22,7 @@ class DIMRED_PT_room(bpy.types.Panel):
         room = context.scene.dimred_room
         row = layout.row(align=True)
         row.operator("dimred.room_click", icon='RESTRICT_SELECT_OFF')
+        row.operator("dimred.look_from_probe", text="", icon='VIEW_CAMERA')
         row.operator("dimred.room_suggest", text="", icon='LIGHT')
         row.operator("dimred.room_load_clicks", text="", icon='FILEBROWSER')
         row.operator("dimred.room_save_clicks", text="", icon='FILE_TICK')

@@ -15,6 +15,7 @@ from ..roommatch import clicks as click_file
 from ..roommatch.clicks import RoomClicks
 from ..roommatch.fit import DEFAULT_CEILING_HEIGHT, RoomFit, fit_room
 from ..roommatch.meshes import NAMES, MeshData, room_meshes
+from ..roommatch.projection import project
 from . import reader
 
 _BOX_FACES = ((0, 3, 2, 1), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7))
@@ -28,6 +29,30 @@ def panorama_rotation(scene: bpy.types.Scene) -> np.ndarray:
         return reader.texture_rotation(reader.environment_texture(scene))
     except DimredError:
         return np.eye(3)
+
+
+def panorama_pixel(scene: bpy.types.Scene, direction: np.ndarray) -> tuple[float, float, int, int]:
+    """The pixel (x, y) of the world's panorama that the world `direction` (3,) shows (through the
+    world's Mapping rotation), and the panorama's width and height: where a click in a 3D viewport
+    showing the world lands in the panorama."""
+    width, height = reader.panorama_size(scene)
+    x, y = project(np.asarray(direction, dtype=np.float64), width, height, panorama_rotation(scene))
+    return float(x), float(y), width, height
+
+
+def probe_camera(scene: bpy.types.Scene, name: str = "Probe Camera") -> bpy.types.Object:
+    """The camera `name` (made where missing: a wide lens looking level) moved to the probe centre
+    and made the scene's camera, so that looking through it shows the panorama as seen from there."""
+    obj = scene.objects.get(name)
+    if obj is None or obj.type != 'CAMERA':
+        data = bpy.data.cameras.new(name)
+        data.lens, data.clip_start = 12.0, 0.01  # 113 degrees across on a 36 mm sensor
+        obj = bpy.data.objects.new(name, data)
+        obj.rotation_euler = (np.pi / 2, 0.0, 0.0)
+        scene.collection.objects.link(obj)
+    obj.location = tuple(reader.probe_center(scene))
+    scene.camera = obj
+    return obj
 
 
 def match_room(scene: bpy.types.Scene, clicks: RoomClicks, *,

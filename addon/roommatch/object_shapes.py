@@ -10,6 +10,7 @@ prism's height is the one whose silhouette agrees best with the outline.
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from typing import Any
 
@@ -72,7 +73,9 @@ def object_from_click(panorama: np.ndarray, click: tuple[float, float], *, click
     box = box_in_outline(outline, click)
     plain = ObjectProxy(_box_solid(box), "box", box.size, box.agreement, box.outline_pixels, box.summary())
     stepped = max((_stepped(box, outline, axis) for axis in (0, 1)), key=lambda proxy: proxy.agreement)
-    return stepped if stepped.agreement >= box.agreement + _STEP_GAIN else plain
+    if stepped.agreement < box.agreement + _STEP_GAIN:
+        return plain
+    return dataclasses.replace(stepped, details={**stepped.details, "box_agreement": round(box.agreement, 4)})
 
 
 def object_from_footprint(panorama: np.ndarray, footprint: tuple[tuple[float, float], ...], *,

@@ -181,6 +181,35 @@ def test_object_from_footprint_builds_a_prism_of_the_fitted_height(panorama_room
     assert scene.dimred.target.name == "Chair"
 
 
+def test_clicks_in_a_view_from_the_probe_land_on_the_panorama(panorama_room: np.ndarray) -> None:
+    from mathutils import Vector
+
+    from addon.blender import room_builder
+    from tests.engine.roommatch.room_truth import rotation_z
+
+    scene = bpy.context.scene
+    tree = scene.world.node_tree  # the world turned 40 degrees by a Mapping node
+    mapping = tree.nodes.new("ShaderNodeMapping")
+    mapping.inputs["Rotation"].default_value[2] = np.radians(40.0)
+    tree.links.new(tree.nodes.new("ShaderNodeTexCoord").outputs["Generated"], mapping.inputs["Vector"])
+    tree.links.new(mapping.outputs["Vector"], tree.nodes["Environment Texture"].inputs["Vector"])
+    turned = rotation_z(40.0)
+    _click_all(clicks_of(floor_points(BOX), PROBE, W, H, turned))
+    scene.dimred_room.camera_height = 1.5
+    bpy.ops.dimred.match_room()
+    assert bpy.ops.dimred.look_from_probe() == {'FINISHED'}
+    camera = scene.camera
+    assert camera.name == "Probe Camera" and tuple(camera.location) == pytest.approx(tuple(PROBE))
+    assert bpy.data.objects["Walls"].display_type == 'WIRE'  # the world shows through the room
+    # The view ray through the middle of the camera's frame, aimed at a corner of the room.
+    corner = Vector((3.0, 2.5, 0.0))
+    camera.rotation_euler = (corner - camera.location).to_track_quat('-Z', 'Y').to_euler()
+    bpy.context.view_layer.update()
+    x, y, width, height = room_builder.panorama_pixel(scene, -np.array(camera.matrix_world.col[2][:3]))
+    expected = clicks_of(np.array([[3.0, 2.5, 0.0]]), PROBE, W, H, turned, rounded=False)[0]
+    assert (width, height) == (W, H) and (x, y) == pytest.approx(tuple(expected), abs=0.01)
+
+
 def test_suggest_room_proposes_the_corners(panorama_room: np.ndarray, tmp_path: Path) -> None:
     from addon.blender import room_builder
 

@@ -8,7 +8,11 @@ the apartment's window wall (the French door's bottom frame 2.5-3 px above the f
 a dark band below it, the offsets split between the two: 2.9 px); the hotel room's (interior.exr)
 floor edges, all behind its bed, desk, armchair and curtains (the curtains' wavy hem scatters
 2.3 px about the window wall's). The apartment's pillar shows two faces at its foot (a corner at
-(76, 170) between them, 1.3 px; one face through both was 4.2 px off).
+(76, 170) between them, 1.3 px; one face through both was 4.2 px off). The lobby's corners are
+where its walls' feet, traced column by column on the photograph (a recessed corridor, benches,
+the reception desk and the stairs left out), cross: its far wall's foot is clear (0.8 px); its
+green wall's foot is behind benches, the wall left of the far one is no one plane (3.6-4.1 px),
+and the stairs' side is the lowest step's edge.
 """
 from __future__ import annotations
 
@@ -30,6 +34,7 @@ CLEAR = {
     "apartment": ("floor 1", "floor 2", "floor 3", "floor 5", "floor 6", "floor 7", "ceiling 0", "ceiling 1",
                   "ceiling 5", "corner 2", "corner 5"),
     "interior": ("ceiling 3",),
+    "lobby": ("floor 1",),
 }
 
 
