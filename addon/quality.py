@@ -28,6 +28,9 @@ class Params:
     fine_pixels: float = 5.0  # ... and at most this many panorama pixels wide at the object's distance
     reach: float = 0.1  # the object's neighbourhood (fine lattice): where its solid angle exceeds this
     significance: float = 0.01  # shadow of a light computed per pixel where it can change E by this share
+    # ... its visibility traced at the corners of cells this many working pixels wide, and
+    # interpolated inside where they agree to within that share (1: traced at every pixel)
+    shadow_cell: int = 4
     bright_factor: float = 4.0  # important senders are this many times brighter than the median patch
     patch_samples: int = 2  # k*k points average the first-order change over patches near the object
     max_bounces: int = 8  # propagation of the change around the room
@@ -82,7 +85,7 @@ PRESETS = {
     # (more patches or patch samples raised it by up to 0.02); the sampled shadows and the finer
     # grid near the object lower it, at about twice balanced's time at 1024x512.
     "final": Params(sender_fraction=0.995, max_senders=64, sender_samples=6, fine_cells=5.0, fine_pixels=3.0,
-                    significance=0.003, max_bounces=16, insertion_passes=3, working_width=2048,
+                    significance=0.003, shadow_cell=2, max_bounces=16, insertion_passes=3, working_width=2048,
                     refine_pixels=800_000),
 }
 
@@ -111,7 +114,8 @@ def working_width_problem(width: object) -> str | None:
 
 # The solver's accuracy knobs (not the synthesis's, not the relocation's passes).
 _SOLVER_FIELDS = ("patches", "object_patches", "sender_fraction", "max_senders", "sender_samples", "fine_cells",
-                  "fine_pixels", "reach", "significance", "patch_samples", "max_bounces", "bounce_tolerance")
+                  "fine_pixels", "reach", "significance", "shadow_cell", "patch_samples", "max_bounces",
+                  "bounce_tolerance")
 
 
 def rough(params: Params) -> Params:

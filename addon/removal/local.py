@@ -10,14 +10,15 @@ import numpy as np
 from ..callbacks import RunCallbacks
 from ..light.formfactor import paired_point_to_triangle
 from ..light.planner import neighbourhood
+from ..light.radiosity import LUMA
 from ..light.transport import pair_visibility
 from ..quality import Params
 from ..report import Report
 from .interpolation import interpolate
 from .irradiance import before_and_after, fine_light, point_light
 from .lit_room import LitRoom
-from .occlusion import Occlusion
 from .room import Room
+from .shadow_cells import PixelGrid, cell_shadows
 from .significance import significant
 from .target import Target
 from .trace import Traced
@@ -44,6 +45,7 @@ class Receiving:
     corners: np.ndarray  # (N, 3) receiver rows of the coarse lattice vertices each interpolates
     weights: np.ndarray  # (N, 3) their weights
     relit: np.ndarray  # (N,) bool: may change (not hidden, not a light, on a relit plane)
+    grid: PixelGrid | None = None  # where the points lie in the panorama, for shadows traced per cell
 
 
 def traced_receiving(traced: Traced, room: Room, target: Target) -> Receiving:
@@ -53,7 +55,8 @@ def traced_receiving(traced: Traced, room: Room, target: Target) -> Receiving:
         relit &= np.isin(traced.obj_h, target.planes)
     return Receiving(points=traced.points_h, normals=traced.normals_h, tri=traced.tri_h,
                      bary=traced.hits.bary.reshape(-1, 2)[traced.hp], corners=room.pixels.corners_h,
-                     weights=room.pixels.weights_h, relit=relit)
+                     weights=room.pixels.weights_h, relit=relit,
+                     grid=PixelGrid(traced.hp, traced.height, traced.width))
 
 
 def local_light(lit: LitRoom, traced: Traced, params: Params, rep: Report, callbacks: RunCallbacks) -> LocalLight:
@@ -65,19 +68,25 @@ def local_light(lit: LitRoom, traced: Traced, params: Params, rep: Report, callb
     else:
         rep.info["fine_vertices"] = light.fine_vertices
         rep.info["exact_pairs"] = light.exact_pairs
+        rep.info["shadow_cells"] = {"cell": params.shadow_cell, "tolerance": params.significance,
+                                    "interpolated_points": light.interpolated_points,
+                                    "computed_pairs": light.computed_pairs}
     return LocalLight(light.e, light.de)
 
 
 @dataclass(frozen=True)
 class PointLight:
     """E and dE (N, 3) at receiving points, and what it took: the points the object affects,
-    the fine lattice's vertices and the (point, sender) pairs given exact visibility."""
+    the fine lattice's vertices, the (point, sender) pairs given exact shadows, the points
+    that took them from their cell's corners and the pairs computed (`shadow_cells`)."""
 
     e: np.ndarray
     de: np.ndarray
     affected: int
     fine_vertices: int
     exact_pairs: int
+    interpolated_points: int = 0
+    computed_pairs: int = 0
 
 
 def light_at(lit: LitRoom, receiving: Receiving, params: Params, callbacks: RunCallbacks, *,
@@ -109,12 +118,9 @@ def light_at(lit: LitRoom, receiving: Receiving, params: Params, callbacks: RunC
     # Base for the pixel: the coarse lattice, or near the object a fine one (only the
     # vertices the pixels use): the split patches' sub-triangles beside the object light
     # the pixels near them unevenly, which coarse vertices would smear over a coarse patch.
-    pair_row, pair_sender = np.nonzero(sig)
-    s = imp[pair_sender]
-    pix = candidate[pair_row]
-    lattice_e = (weights_h[pix] * room.t_with[corners_h[pix], s[:, None]]).sum(axis=1)
     near_pixels = candidate[near]
     fine_vertices = 0
+    fine_row = np.full(len(receiving.points), -1)
     if len(near_pixels):
         fine = (point_light(receiving.points[near_pixels], receiving.normals[near_pixels], lit, callbacks)
                 if per_point else fine_light(lit, receiving.tri[near_pixels], receiving.bary[near_pixels], callbacks))
@@ -122,24 +128,29 @@ def light_at(lit: LitRoom, receiving: Receiving, params: Params, callbacks: RunC
         e_h[near_pixels] = interpolate(fine.e, fine.corners, fine.weights)
         de_h[near_pixels] = interpolate(change(fine.e, fine.e_after, fine.t_with, fine.t_without), fine.corners,
                                         fine.weights)
-        row = np.full(len(receiving.points), -1)
-        row[near_pixels] = np.arange(len(near_pixels))
-        in_fine = row[pix] >= 0
-        k = row[pix[in_fine]]
-        lattice_e[in_fine] = (fine.weights[k] * fine.t_with[fine.corners[k], s[in_fine, None]]).sum(axis=1)
-    _add_exact_shadows(e_h, de_h, receiving, lit.occlusion, room, pix, s, lattice_e, callbacks)
-    return PointLight(e_h, de_h, affected, fine_vertices, len(s))
+        fine_row[near_pixels] = np.arange(len(near_pixels))
 
+    def lattice_share(pix: np.ndarray, s: np.ndarray) -> np.ndarray:
+        """(n,) the transport of the pairs (pixel pix, sender s) that E at the pixel holds."""
+        share = (weights_h[pix] * room.t_with[corners_h[pix], s[:, None]]).sum(axis=1)
+        in_fine = fine_row[pix] >= 0
+        if in_fine.any():
+            k = fine_row[pix[in_fine]]
+            share[in_fine] = (fine.weights[k] * fine.t_with[fine.corners[k], s[in_fine, None]]).sum(axis=1)
+        return share
 
-def _add_exact_shadows(e_h: np.ndarray, de_h: np.ndarray, receiving: Receiving, occlusion: Occlusion, room: Room,
-                       pix: np.ndarray, s: np.ndarray, lattice_e: np.ndarray, callbacks: RunCallbacks) -> None:
-    """Replace, in the arrays being built, the lattice's share `lattice_e` of the pairs (pixel
-    pix, important sender s) by exact form factors and sampled visibility."""
-    b = room.senders.radiosity
-    senders = room.senders
-    f = paired_point_to_triangle(receiving.points[pix], receiving.normals[pix], senders.triangles[s],
-                                 senders.normals[s])
-    vis, vis_w = pair_visibility(receiving.points, senders, pix, s, occlusion.removed, occlusion.others,
-                                 callbacks.check)
-    np.add.at(e_h, pix, (f * vis - lattice_e)[:, None] * b[s])
-    np.add.at(de_h, pix, (f * (vis_w - vis))[:, None] * b[s])
+    def shadow(pix: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """What replacing the lattice's share of the pairs by exact form factors and sampled
+        visibility adds to E and dE (each (n, 3))."""
+        f = paired_point_to_triangle(receiving.points[pix], receiving.normals[pix], room.senders.triangles[s],
+                                     room.senders.normals[s])
+        vis, vis_w = pair_visibility(receiving.points, room.senders, pix, s, lit.occlusion.removed,
+                                     lit.occlusion.others, callbacks.check)
+        return (f * vis - lattice_share(pix, s))[:, None] * b[s], (f * (vis_w - vis))[:, None] * b[s]
+
+    pair_row, pair_sender = np.nonzero(sig)
+    shadows = cell_shadows(receiving.points, receiving.normals, receiving.relit, receiving.grid,
+                           candidate[pair_row], imp[pair_sender], params.significance * np.maximum(e_h @ LUMA, 0.0),
+                           shadow, cell=params.shadow_cell)
+    return PointLight(e_h + shadows.e, de_h + shadows.de, affected, fine_vertices, len(pair_row),
+                      shadows.interpolated_points, shadows.exact_pairs)

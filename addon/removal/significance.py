@@ -24,10 +24,12 @@ def significant(senders: Senders, imp: np.ndarray, points: np.ndarray, e_points:
     (the receivers' (N, 3) `e_points`). `margin` widens the object for receivers that stand for
     an area."""
     imp_c, imp_r = sender_spheres(senders, imp)
-    volume = shadow_volume(points, imp_c, imp_r, target.centre, target.radius + np.asarray(margin))
     b_y = senders.radiosity[imp] @ LUMA
     tris = senders.triangles[imp]
     area = np.linalg.norm(np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0]), axis=1) / 2
-    d2 = ((points[:, None, :] - imp_c[None]) ** 2).sum(axis=2) + imp_r[None] ** 2
+    # |p - c|^2 expanded: a matrix product instead of an (N, I, 3) array of differences.
+    d2 = np.maximum(np.einsum("ij,ij->i", points, points)[:, None] - 2.0 * points @ imp_c.T
+                    + np.einsum("ij,ij->i", imp_c, imp_c)[None], 0.0) + imp_r[None] ** 2
     bound = b_y[None] * area[None] / (np.pi * d2)
-    return volume & (bound >= params.significance * np.maximum(e_points @ LUMA, 1e-30)[:, None])
+    worth = bound >= params.significance * np.maximum(e_points @ LUMA, 1e-30)[:, None]
+    return shadow_volume(points, imp_c, imp_r, target.centre, target.radius + np.asarray(margin), only=worth)

@@ -1,0 +1,146 @@
+"""The object's shadows of the important senders at panorama pixels, computed exactly at the
+corners of square cells of pixels and interpolated inside a cell where its corners agree.
+
+A large emitter (a window, a lit wall) shadows much of the room softly: its object shadow is
+significant at most pixels but changes slowly from pixel to pixel, so computing every pixel's
+pairs costs what the window's area costs, not what the shadow's detail needs. A cell's corners
+get the exact shadow of every sender significant anywhere in the cell; where the spread of
+those corner values, summed over the senders, stays under the budget of each corner (a share
+of its light), every pixel of the cell on the corners' plane takes the bilinear mix of them.
+Elsewhere (the shadow's sharp edge, the object's outline, a change of surface, a corner hidden
+behind the object) each pixel gets its own. As the exact values inside a smooth cell lie
+between its corners', the spread bounds what the mix gets wrong; a feature of the object
+narrower than a cell whose shadow passes between all four corners breaks that, so the cell is
+kept to a few pixels, narrower than the legs of the furniture it meets.
+"""
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..light.radiosity import LUMA
+
+_SAME_PLANE_COS = 0.999  # corners whose normal turns further are on another surface
+_SAME_PLANE_GAP = 1e-3  # ... or that lie further off the pixel's plane, as a share of its distance
+
+#: The exact shadow of pairs (receiving rows (n,), senders (n,)): what it adds to E and to dE,
+#: each (n, 3).
+PairShadow = Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]
+
+
+@dataclass(frozen=True)
+class PixelGrid:
+    """Where the receiving points lie in the panorama: the flat index (N,) of each point's
+    pixel in a `height` x `width` image."""
+
+    flat: np.ndarray
+    height: int
+    width: int
+
+
+@dataclass(frozen=True)
+class CellShadows:
+    """What the shadows add to E and dE at every receiving point (N, 3), the points that took
+    them from their cell's corners, and the (point, sender) pairs computed exactly (at the
+    corners and at the other points)."""
+
+    e: np.ndarray
+    de: np.ndarray
+    interpolated_points: int
+    exact_pairs: int
+
+
+def cell_shadows(points: np.ndarray, normals: np.ndarray, usable: np.ndarray, grid: PixelGrid | None,
+                 rows: np.ndarray, senders: np.ndarray, budget: np.ndarray, shadow: PairShadow, *,
+                 cell: int) -> CellShadows:
+    """The shadows of the significant pairs (receiving rows `rows`, senders `senders`): at the
+    points with pairs, exact or from their cells of `cell` pixels on `grid` (None, or a cell of
+    1: all exact). Corners must be `usable` (N,) rows; `budget` (N,) is the luminance a corner's
+    interpolation may get wrong."""
+    n = len(points)
+    e, de = np.zeros((n, 3)), np.zeros((n, 3))
+    interpolated = np.zeros(n, dtype=bool)
+    exact_pairs = 0
+    if grid is not None and cell > 1 and len(rows):
+        served, corner_e, corner_de, corner_pairs = _smooth_cells(points, normals, usable, grid, rows, senders,
+                                                                  budget, shadow, cell)
+        exact_pairs += corner_pairs
+        if len(served.rows):
+            e[served.rows] = np.einsum("nk,nkc->nc", served.weights, corner_e[served.cell])
+            de[served.rows] = np.einsum("nk,nkc->nc", served.weights, corner_de[served.cell])
+            interpolated[served.rows] = True
+    own = ~interpolated[rows]
+    add_e, add_de = shadow(rows[own], senders[own])
+    e += _sum_rows(rows[own], add_e, n)
+    de += _sum_rows(rows[own], add_de, n)
+    return CellShadows(e, de, int(interpolated.sum()), exact_pairs + int(own.sum()))
+
+
+@dataclass(frozen=True)
+class _Served:
+    """Points served by a smooth cell: their rows (m,), cells (m,) and corner weights (m, 4)."""
+
+    rows: np.ndarray
+    cell: np.ndarray
+    weights: np.ndarray
+
+
+def _smooth_cells(points: np.ndarray, normals: np.ndarray, usable: np.ndarray, grid: PixelGrid, rows: np.ndarray,
+                  senders: np.ndarray, budget: np.ndarray, shadow: PairShadow, cell: int
+                  ) -> tuple[_Served, np.ndarray, np.ndarray, int]:
+    """The points served by cells whose corners agree, the summed shadow (C, 4, 3) at each
+    cell's corners for E and for dE, and the pairs computed at corners."""
+    row_of = np.full(grid.height * grid.width, -1)
+    row_of[grid.flat] = np.arange(len(grid.flat))
+    r, c = np.divmod(grid.flat, grid.width)
+    cols = -(-grid.width // cell)
+    key = (r // cell) * cols + c // cell  # (N,) each point's cell
+    cells, cell_of = np.unique(key[rows], return_inverse=True)
+    # The cell's corner pixels, wrapping around in longitude; a cell past the last row has none.
+    r0, c0 = (cells // cols) * cell, (cells % cols) * cell
+    r1, c1 = r0 + cell, (c0 + cell) % grid.width
+    inside = r1 < grid.height
+    r1 = np.minimum(r1, grid.height - 1)
+    corner = row_of[np.stack([r0 * grid.width + c0, r0 * grid.width + c1, r1 * grid.width + c0,
+                              r1 * grid.width + c1], axis=1)]
+    ok = inside & (corner >= 0).all(axis=1)
+    corner = np.where(ok[:, None], corner, 0)
+    ok &= usable[corner].all(axis=1)
+
+    # Every sender significant somewhere in a cell is taken at all four of its corners.
+    pair = np.unique(cell_of * (senders.max() + 1) + senders)
+    pair_cell, pair_sender = np.divmod(pair, senders.max() + 1)
+    keep = ok[pair_cell]
+    pair_cell, pair_sender = pair_cell[keep], pair_sender[keep]
+    at = corner[pair_cell]  # (m, 4)
+    unique, inverse = np.unique(at * (senders.max() + 1) + pair_sender[:, None], return_inverse=True)
+    u_e, u_de = shadow(unique // (senders.max() + 1), unique % (senders.max() + 1))
+    inverse = inverse.reshape(-1, 4)
+    spread = np.maximum(np.ptp(u_e[inverse] @ LUMA, axis=1), np.ptp(u_de[inverse] @ LUMA, axis=1))
+    spread_cell = np.bincount(pair_cell, spread, minlength=len(cells))
+    smooth = ok & (spread_cell <= budget[corner].min(axis=1))
+    corner_e, corner_de = np.zeros((len(cells), 4, 3)), np.zeros((len(cells), 4, 3))
+    for k in range(4):
+        corner_e[:, k] = _sum_rows(pair_cell, u_e[inverse[:, k]], len(cells))
+        corner_de[:, k] = _sum_rows(pair_cell, u_de[inverse[:, k]], len(cells))
+
+    # The points with pairs in smooth cells, on the plane of all four corners.
+    p = np.unique(rows)
+    p_cell = np.searchsorted(cells, key[p])
+    p, p_cell = p[smooth[p_cell]], p_cell[smooth[p_cell]]
+    corners_p = corner[p_cell]
+    facing = np.einsum("nc,nkc->nk", normals[p], normals[corners_p]) >= _SAME_PLANE_COS
+    off = np.abs(np.einsum("nc,nkc->nk", normals[p], points[corners_p] - points[p][:, None, :]))
+    flat = (facing & (off <= _SAME_PLANE_GAP * np.linalg.norm(points[p], axis=1)[:, None])).all(axis=1)
+    p, p_cell = p[flat], p_cell[flat]
+    fr = (r[p] - r0[p_cell]) / cell
+    fc = ((c[p] - c0[p_cell]) % grid.width) / cell
+    weights = np.stack([(1 - fr) * (1 - fc), (1 - fr) * fc, fr * (1 - fc), fr * fc], axis=1)
+    return _Served(p, p_cell, weights), corner_e, corner_de, len(unique)
+
+
+def _sum_rows(rows: np.ndarray, values: np.ndarray, n: int) -> np.ndarray:
+    """(n, C): values (k, C) summed into their rows."""
+    return np.stack([np.bincount(rows, values[:, c], minlength=n) for c in range(values.shape[1])], axis=1)
