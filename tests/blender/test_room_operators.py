@@ -42,6 +42,26 @@ def _click_all(points: np.ndarray) -> None:
         bpy.ops.dimred.room_click(kind='FLOOR', x=float(x), y=float(y))
 
 
+def _show_chair(folder: Path, chair: np.ndarray) -> None:
+    """Make the world show the box room at 1024 x 512 with an olive box (`silhouette`'s parameters) in it."""
+    from addon.blender import room_builder
+    from tests.engine.roommatch.room_truth import with_box
+
+    hdri = folder / "chair.exr"
+    tiny_scene.write_exr(hdri, with_box(flat_panorama(BOX, CEILING, PROBE, 1024, 512), chair, 1.5, (0.7, 0.6, 0.1)))
+    room_builder.show_panorama(bpy.context.scene, str(hdri))
+
+
+def _chair_in_matched_room(folder: Path) -> np.ndarray:
+    """The box room with an armchair-sized box, matched from its corners' clicks; the box's parameters."""
+    chair = np.array([1.8, 0.6, np.log(0.8), np.log(0.7), np.log(0.9), np.radians(20.0)])
+    _show_chair(folder, chair)
+    _click_all(clicks_of(floor_points(BOX), PROBE, 1024, 512))
+    bpy.context.scene.dimred_room.camera_height = 1.5
+    bpy.ops.dimred.match_room()
+    return chair
+
+
 def test_match_room_builds_the_room_the_clicks_show(panorama_room: np.ndarray) -> None:
     scene = bpy.context.scene
     _click_all(panorama_room)
@@ -134,17 +154,8 @@ def test_snap_to_photo_moves_the_clicks_onto_the_walls(panorama_room: np.ndarray
 
 def test_object_from_photo_boxes_the_clicked_object(panorama_room: np.ndarray, tmp_path: Path) -> None:
     from addon.roommatch.projection import project
-    from tests.engine.roommatch.room_truth import with_box
 
-    chair = np.array([1.8, 0.6, np.log(0.8), np.log(0.7), np.log(0.9), np.radians(20.0)])
-    hdri = tmp_path / "chair.exr"
-    tiny_scene.write_exr(hdri, with_box(flat_panorama(BOX, CEILING, PROBE, 1024, 512), chair, 1.5, (0.7, 0.6, 0.1)))
-    from addon.blender import room_builder
-
-    room_builder.show_panorama(bpy.context.scene, str(hdri))
-    _click_all(clicks_of(floor_points(BOX), PROBE, 1024, 512))
-    bpy.context.scene.dimred_room.camera_height = 1.5
-    bpy.ops.dimred.match_room()
+    chair = _chair_in_matched_room(tmp_path)
     x, y = np.round(project(np.array([1.8, 0.6, 0.45 - 1.5]), 1024, 512))
     assert bpy.ops.dimred.object_from_photo(x=float(x), y=float(y), name="Chair") == {'FINISHED'}
     corners = _vertices("Chair")
@@ -155,18 +166,10 @@ def test_object_from_photo_boxes_the_clicked_object(panorama_room: np.ndarray, t
 
 
 def test_object_from_footprint_builds_a_prism_of_the_fitted_height(panorama_room: np.ndarray, tmp_path: Path) -> None:
-    from addon.blender import room_builder
     from addon.roommatch.object_box import BoxFit
-    from tests.engine.roommatch.room_truth import with_box
 
-    chair = np.array([1.8, 0.6, np.log(0.8), np.log(0.7), np.log(0.9), np.radians(20.0)])
-    hdri = tmp_path / "chair.exr"
-    tiny_scene.write_exr(hdri, with_box(flat_panorama(BOX, CEILING, PROBE, 1024, 512), chair, 1.5, (0.7, 0.6, 0.1)))
+    chair = _chair_in_matched_room(tmp_path)
     scene = bpy.context.scene
-    room_builder.show_panorama(scene, str(hdri))
-    _click_all(clicks_of(floor_points(BOX), PROBE, 1024, 512))
-    scene.dimred_room.camera_height = 1.5
-    bpy.ops.dimred.match_room()
     bottom = BoxFit(np.array([1.8, 0.6, 0.0]), np.array([0.8, 0.7, 0.0]), np.radians(20.0), 0.0, 0).corners()[:4]
     # Where the box meets the floor (an operator's collection argument names each item).
     feet = [{"name": str(i), "point": tuple(p)} for i, p in enumerate(clicks_of(bottom, PROBE, 1024, 512))]
@@ -239,13 +242,10 @@ def test_suggest_room_says_when_it_finds_nothing(registered, tmp_path: Path) -> 
 def test_fit_box_refits_each_size_of_the_marked_box(panorama_room: np.ndarray, tmp_path: Path) -> None:
     from addon.blender import room_builder
     from addon.roommatch.object_box import BoxFit
-    from tests.engine.roommatch.room_truth import with_box
 
     truth = np.array([1.8, 0.6, np.log(0.8), np.log(0.7), np.log(0.95), np.radians(20.0)])
-    hdri = tmp_path / "chair.exr"
-    tiny_scene.write_exr(hdri, with_box(flat_panorama(BOX, CEILING, PROBE, 1024, 512), truth, 1.5, (0.7, 0.6, 0.1)))
+    _show_chair(tmp_path, truth)
     scene = bpy.context.scene
-    room_builder.show_panorama(scene, str(hdri))
     room_builder.set_probe_center(scene, PROBE)
     # Modelled by eye: 10 cm off, turned 8 degrees too far, 0.8 m high.
     guess = BoxFit(bottom=np.array([1.9, 0.55, 0.0]), size=np.array([0.7, 0.7, 0.8]), turn=np.radians(28.0),
