@@ -4,7 +4,8 @@ Lambert's contour formula, F = 1/(2 pi) sum_edges angle_k * (n . unit(r_k x r_k+
 for a polygon entirely above the receiver's tangent plane. The sender is first clipped to that
 half-space ("horizon clipping"), so the result stays exact and finite even when sender and
 receiver touch (a box standing on the floor), where the point-to-point kernel
-cos*cos*A/(pi d^2) diverges.
+cos*cos*A/(pi d^2) diverges. Far from the receiver (`FAR` radii) that kernel, taken at the
+edge midpoints, is as good and much cheaper.
 """
 from __future__ import annotations
 
@@ -12,6 +13,10 @@ import numpy as np
 
 # Pairs evaluated per chunk: bounds the (pairs, 6, 3) float64 temporaries to ~50 MB.
 _CHUNK = 250_000
+# A triangle wholly above the horizon and farther than this many times its radius takes the
+# kernel cos*cos/(pi d^2) at its edge midpoints (exact for a quadratic kernel): the error
+# is of order (radius / d)^3, under 0.5 % there, at a tenth of the contour's cost.
+FAR = 6.0
 
 
 def _forward_fill(valid: np.ndarray) -> np.ndarray:
@@ -68,10 +73,25 @@ def _pairs(rel: np.ndarray, n: np.ndarray, sender_normals: np.ndarray | None, ep
     whole = some & above.all(axis=1)
     part = some & ~whole
     f = np.zeros(len(rel))
+    centre = rel.mean(axis=1)
+    reach2 = ((rel - centre[:, None, :]) ** 2).sum(axis=2).max(axis=1)
+    far = whole & (np.einsum("pc,pc->p", centre, centre) > FAR**2 * reach2)
+    f[far] = _midpoints(rel[far], n[far])
+    whole &= ~far
     f[whole] = _contour(_unit(rel[whole]), n[whole])
     if part.any():
         f[part] = _clip_and_integrate(rel[part], n[part], eps)
     return f
+
+
+def _midpoints(rel: np.ndarray, n: np.ndarray) -> np.ndarray:
+    """The point-to-point kernel of triangles rel (P, 3, 3) wholly above the horizon of
+    receivers with normals n (P, 3), integrated at the triangles' edge midpoints."""
+    area = 0.5 * np.cross(rel[:, 1] - rel[:, 0], rel[:, 2] - rel[:, 0])  # (P, 3) area times normal
+    mid = 0.5 * (rel + np.roll(rel, -1, axis=1))  # (P, 3, 3)
+    d2 = np.einsum("pkc,pkc->pk", mid, mid)
+    kernel = np.einsum("pkc,pc->pk", mid, n) * np.abs(np.einsum("pkc,pc->pk", mid, area)) / (d2 * d2)
+    return kernel.sum(axis=1) / (3.0 * np.pi)
 
 
 def point_to_triangle(
