@@ -250,8 +250,10 @@ def silhouette(params: np.ndarray, directions: np.ndarray, camera: float) -> np.
     with np.errstate(divide="ignore", invalid="ignore"):
         t1 = (-half - origin) / local
         t2 = (half - origin) / local
-    near = np.nanmax(np.minimum(t1, t2), axis=-1)
-    far = np.nanmin(np.maximum(t1, t2), axis=-1)
+    low, high = np.minimum(t1, t2), np.maximum(t1, t2)
+    # fmax and fmin skip a NaN (a ray lying in a slab's plane) as nanmax does; unrolled over the axes, faster
+    near = np.fmax(np.fmax(low[..., 0], low[..., 1]), low[..., 2])
+    far = np.fmin(np.fmin(high[..., 0], high[..., 1]), high[..., 2])
     return far >= np.maximum(near, 0.0)
 
 
