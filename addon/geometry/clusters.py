@@ -16,6 +16,7 @@ import numpy as np
 
 _ITERATIONS = 12  # Lloyd steps: the assignment settles within a few on smooth meshes
 _SAMPLE = 8192  # triangles at most that the centres are fitted to
+_CHUNK = 8192  # triangles assigned to their nearest centre at a time
 
 
 @dataclass
@@ -102,5 +103,11 @@ def _farthest_points(features: np.ndarray, count: int) -> np.ndarray:
 
 
 def _nearest(features: np.ndarray, centres: np.ndarray) -> np.ndarray:
-    d2 = (features**2).sum(axis=1)[:, None] - 2.0 * features @ centres.T + (centres**2).sum(axis=1)[None]
-    return d2.argmin(axis=1)
+    """(N,) the nearest of `centres` (C, F) to each of `features` (N, F), _CHUNK rows at a time:
+    the (N, C) distances of a 200k-triangle object would be 150 MB per temporary."""
+    out = np.empty(len(features), dtype=np.int64)
+    c2 = (centres**2).sum(axis=1)[None]
+    for i0 in range(0, len(features), _CHUNK):
+        f = features[i0 : i0 + _CHUNK]
+        out[i0 : i0 + _CHUNK] = ((f**2).sum(axis=1)[:, None] - 2.0 * f @ centres.T + c2).argmin(axis=1)
+    return out
