@@ -124,28 +124,61 @@ def pair_visibility(
     others: Occluders | None, check: Callable[[], None] | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Visible fractions of sender s[i] from point r[i]: with the removed object, and without it.
-    `check()` is called between chunks (it raises to cancel)."""
+    `check()` is called between chunks (it raises to cancel).
+
+    Only the pairs whose segments can pass the removed object's bounding sphere are traced
+    against it (a sender's segments all lie within its samples' sphere of the segment to their
+    centre): most of a room's pairs pass nowhere near it, and without other occluders they
+    need no ray at all."""
     vis = np.zeros(len(r))
     vis_without = np.zeros(len(r))
+    sphere = None if removed is None else _sphere(removed)
     for g, (samples, weights) in enumerate(zip(senders.samples, senders.weights, strict=True)):
         sel = np.flatnonzero(senders.group[s] == g)
         if not len(sel):
             continue
         m = samples.shape[1]
+        centre = samples.mean(axis=1)
+        reach = np.sqrt(((samples - centre[:, None, :]) ** 2).sum(axis=2).max(axis=1))
         per = max(1, _SEGMENTS_PER_CHUNK // m)
         for i0 in range(0, len(sel), per):
             if check is not None:
                 check()
             k = sel[i0 : i0 + per]
-            p0 = np.repeat(points[r[k]], m, axis=0)
-            p1 = samples[senders.slot[s[k]]].reshape(-1, 3)
-            b_o = removed.blocked(p0, p1) if removed is not None else np.zeros(len(p0), dtype=bool)
-            b_x = others.blocked(p0, p1) if others is not None else np.zeros(len(p0), dtype=bool)
-            w = weights[senders.slot[s[k]]]
-            vis[k] = ((~(b_o | b_x)).reshape(-1, m) * w).sum(axis=1)
-            vis_without[k] = ((~b_x).reshape(-1, m) * w).sum(axis=1)
+            slot = senders.slot[s[k]]
+            free = np.ones((len(k), m), dtype=bool)  # by the removed object
+            free_without = np.ones((len(k), m), dtype=bool)  # by every other occluder
+            if sphere is not None:
+                near = _passes(points[r[k]], centre[slot], reach[slot], *sphere)
+                free[near] = ~_blocked(removed, points[r[k[near]]], samples[slot[near]])
+            if others is not None:
+                free_without = ~_blocked(others, points[r[k]], samples[slot])
+            w = weights[slot]
+            vis[k] = ((free & free_without) * w).sum(axis=1)
+            vis_without[k] = (free_without * w).sum(axis=1)
     vis_without = np.where(senders.on_removed[s], 0.0, vis_without)
     return vis, vis_without
+
+
+def _sphere(occluders: Occluders) -> tuple[np.ndarray, float]:
+    """Centre (3,) and radius of a sphere holding all the occluders' (grown) boxes."""
+    lo, hi = occluders.lo[0].min(axis=1), occluders.hi[0].max(axis=1)
+    return 0.5 * (lo + hi), 0.5 * float(np.linalg.norm(hi - lo))
+
+
+def _passes(points: np.ndarray, ends: np.ndarray, reach: np.ndarray, centre: np.ndarray, radius: float
+            ) -> np.ndarray:
+    """(n,) whether a segment from points[i] to within reach[i] of ends[i] can meet the sphere."""
+    d = ends - points
+    t = np.clip(np.einsum("ij,ij->i", centre - points, d) / np.maximum(np.einsum("ij,ij->i", d, d), 1e-300), 0, 1)
+    gap = points + t[:, None] * d - centre
+    return np.einsum("ij,ij->i", gap, gap) <= (radius + reach) ** 2
+
+
+def _blocked(occluders: Occluders, points: np.ndarray, samples: np.ndarray) -> np.ndarray:
+    """(n, m) whether the segments from points (n, 3) to their samples (n, m, 3) are blocked."""
+    n, m = samples.shape[:2]
+    return occluders.blocked(np.repeat(points, m, axis=0), samples.reshape(-1, 3)).reshape(n, m)
 
 
 def transport(
