@@ -12,6 +12,7 @@ from ..geometry.resample import resample_axis
 from ..segmentation.diagnostics import _srgb, _tone_map
 from .clicks import RoomClicks
 from .fit import RoomFit
+from .hull import Hull
 from .meshes import room_edges
 from .projection import project
 from .solids import Solid
@@ -21,12 +22,12 @@ _COLOURS = np.array([[0.1, 1.0, 0.2], [1.0, 0.2, 1.0], [0.0, 1.0, 1.0], [1.0, 0.
 # A box's 12 edges between its corners (the bottom four, then the top four).
 _BOX_EDGES = np.array([(0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (5, 6), (6, 7), (7, 4), (0, 4), (1, 5), (2, 6), (3, 7)])
 _CLICK = np.array([1.0, 0.9, 0.0], dtype=np.float32)
-_SAMPLES = 4000  # along one edge: under half a pixel apart at 2048 wide
+_SAMPLES = 4000  # along one edge at most: under half a pixel apart at 2048 wide
 
 
 def room_picture(panorama: np.ndarray, room: RoomFit, clicks: RoomClicks | None = None, *,
-                 boxes: tuple[np.ndarray, ...] = (), solids: tuple[Solid, ...] = (), rotation: np.ndarray | None = None,
-                 max_width: int = 2048) -> np.ndarray:
+                 boxes: tuple[np.ndarray, ...] = (), solids: tuple[Solid | Hull, ...] = (),
+                 rotation: np.ndarray | None = None, max_width: int = 2048) -> np.ndarray:
     """(h, w, 3) uint8 sRGB picture of `panorama` (H, W, 3) linear RGB, top row first, reduced
     to at most `max_width` wide, with `room`'s edges, the `boxes` ((8, 3) world corners each),
     the object proxies `solids` and the `clicks` drawn."""
@@ -40,12 +41,15 @@ def room_picture(panorama: np.ndarray, room: RoomFit, clicks: RoomClicks | None 
     objects = [np.asarray(corners, dtype=np.float64)[_BOX_EDGES] for corners in boxes]
     objects += [solid.edges() for solid in solids]
     edges = np.concatenate([walls, *objects]) - room.probe
-    t = np.linspace(0.0, 1.0, _SAMPLES)[None, :, None]
-    points = edges[:, :1] + t * (edges[:, 1:] - edges[:, :1])
-    xy = project(points, width, height, rotation)
     kind = np.concatenate([np.repeat(np.arange(3), len(walls) // 3), np.full(len(edges) - len(walls), 3)])
-    colour = np.broadcast_to(_COLOURS[kind][:, None, :], (*xy.shape[:2], 3))
-    _stamp(picture, xy.reshape(-1, 2), colour.reshape(-1, 3), radius=1)
+    # Each edge sampled under half a pixel apart: a carved proxy's many short edges take few samples.
+    ends = edges / np.maximum(np.linalg.norm(edges, axis=2, keepdims=True), 1e-12)
+    angle = np.arccos(np.clip(np.einsum("ij,ij->i", ends[:, 0], ends[:, 1]), -1.0, 1.0))
+    count = np.clip(np.ceil(angle * width / np.pi).astype(np.int64) + 2, 2, _SAMPLES)
+    edge = np.repeat(np.arange(len(edges)), count)
+    t = ((np.arange(len(edge)) - np.repeat(np.cumsum(count) - count, count)) / (count[edge] - 1))[:, None]
+    points = edges[edge, 0] + t * (edges[edge, 1] - edges[edge, 0])
+    _stamp(picture, project(points, width, height, rotation), _COLOURS[kind[edge]], radius=1)
     if clicks is not None:
         scale = np.array([width / clicks.width, height / clicks.height])
         named = [*clicks.floor, *([clicks.ceiling] if clicks.ceiling is not None else [])]

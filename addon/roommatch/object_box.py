@@ -88,7 +88,8 @@ def outline_at(panorama: np.ndarray, click: tuple[float, float], *, click_size: 
     # The segmentation decides a wide band on halved copies first: the seed must survive them.
     halvings = max(0, int(np.ceil(np.log2(band / _COARSEST_BAND))))
     seed = (view.rows[:, None] - view.y) ** 2 + (view.cols[None, :] - view.x) ** 2 <= (_SEED * 2**halvings) ** 2
-    return Outline(_segment(view.image, seed, band), view.directions, camera, probe, floor_z, inside)
+    return Outline(_segment(view.image, seed, band), view.directions, camera, probe, floor_z, inside,
+                   _rotation(rotation))
 
 
 def box_in_outline(outline: Outline, click: tuple[float, float]) -> BoxFit:
@@ -121,7 +122,7 @@ def refit_box(panorama: np.ndarray, corners: np.ndarray, *, probe: np.ndarray, f
     shown = _segment(view.image, proxy, max(2, int(_PROXY_BAND * extent)))
     # From the proxy as modelled, and from the outline's own first box: a turn off by several
     # degrees can hold the search in a nearby optimum.
-    outline = Outline(shown, view.directions, camera, probe, floor_z, inside)
+    outline = Outline(shown, view.directions, camera, probe, floor_z, inside, _rotation(rotation))
     fits = [_fitted(_front(params), outline)]
     points = _floor_points(shown, view.directions, camera)
     if len(points) >= 3:
@@ -167,11 +168,15 @@ def _camera(probe: np.ndarray, floor_z: float) -> tuple[np.ndarray, float]:
     return probe, camera
 
 
+def _rotation(rotation: np.ndarray | None) -> np.ndarray:
+    return np.eye(3) if rotation is None else np.asarray(rotation, dtype=np.float64)
+
+
 @dataclass(frozen=True)
 class Outline:
     """What a proxy is fitted to: the outline (h, w) over a window, its pixels' directions from
-    the probe, the probe's height above the floor, the probe, the floor's z, and the floor
-    polygon ((n, 2) world) the proxy must stand in, if any."""
+    the probe, the probe's height above the floor, the probe, the floor's z, the floor polygon
+    ((n, 2) world) the proxy must stand in, if any, and the panorama's rotation (3, 3)."""
 
     shown: np.ndarray
     directions: np.ndarray
@@ -179,6 +184,7 @@ class Outline:
     probe: np.ndarray
     floor_z: float
     inside: np.ndarray | None
+    rotation: np.ndarray
 
     def cropped(self) -> tuple[np.ndarray, np.ndarray]:
         """The outline and its directions over its bounding box grown by half its size each way:

@@ -19,6 +19,7 @@ import numpy as np
 from ..errors import DimredError
 from .clicks import ObjectClicks
 from .fit import check_simple, unit_floor_points
+from .hull import Hull, Wedges, carve, traced, vertical_columns
 from .object_box import BoxFit, Outline, agreement, box_in_outline, climb, outline_at, silhouette
 from .projection import project
 from .solids import Solid, inside_polygon, prism_silhouette
@@ -27,6 +28,11 @@ _STEP_GAIN = 0.01  # the agreement a stepped box must add to the box's to be kep
 # The stepped box's moves: place (m), log width and depth, turn (rad), the cut (logit), log heights.
 _STEP_MOVES = np.diag([0.05, 0.05, 0.1, 0.1, np.radians(5.0), 0.5, 0.1, 0.1])
 _STEP_BUDGET = 300
+_CARVE_BELOW = 0.95  # a box or stepped box agreeing this well with the outline is kept as it is
+_CARVE_GAIN = 0.02  # the agreement a carved proxy must add to the box's or stepped box's to be kept
+_GROWTH_COST = 0.05  # the agreement a carved proxy's base may give up per share of volume it grows by
+_GROW_MOVES = np.diag([0.03, 0.03, 0.03, 0.03, 0.05])  # each side of the base (m), its heights (log)
+_GROW_BUDGET = 200
 _SEED_HEIGHT = 0.25  # metres above the floor where the footprint's seed is
 _HEIGHTS = np.log(np.geomspace(0.05, 4.0, 40))  # the prism heights tried first (log metres)
 _HEIGHT_MOVES = np.array([[0.05]])
@@ -40,7 +46,7 @@ class ObjectProxy:
     and y), how well its silhouette agrees with the outline (shared over united pixels), the
     outline's pixels, and what the kind adds to the summary."""
 
-    solid: Solid
+    solid: Solid | Hull
     kind: str
     size: np.ndarray
     agreement: float
@@ -71,11 +77,16 @@ def object_from_click(panorama: np.ndarray, click: tuple[float, float], *, click
     outline = outline_at(panorama, click, click_size=click_size, probe=probe, floor_z=floor_z, rotation=rotation,
                          inside=inside)
     box = box_in_outline(outline, click)
-    plain = ObjectProxy(_box_solid(box), "box", box.size, box.agreement, box.outline_pixels, box.summary())
-    stepped = max((_stepped(box, outline, axis) for axis in (0, 1)), key=lambda proxy: proxy.agreement)
-    if stepped.agreement < box.agreement + _STEP_GAIN:
-        return plain
-    return dataclasses.replace(stepped, details={**stepped.details, "box_agreement": round(box.agreement, 4)})
+    proxy = ObjectProxy(_box_solid(box), "box", box.size, box.agreement, box.outline_pixels, box.summary())
+    parts = np.array([[box.bottom[0] - probe[0], box.bottom[1] - probe[1], *np.log(box.size), box.turn]])
+    stepped, step_parts = max((_stepped(box, outline, axis) for axis in (0, 1)), key=lambda fit: fit[0].agreement)
+    if stepped.agreement >= box.agreement + _STEP_GAIN:
+        proxy = dataclasses.replace(stepped, details={**stepped.details, "box_agreement": round(box.agreement, 4)})
+        parts = step_parts
+    if proxy.agreement >= _CARVE_BELOW or not vertical_columns(outline):
+        return proxy
+    carved = _carved(proxy, parts, outline)
+    return carved if carved.agreement >= proxy.agreement + _CARVE_GAIN else proxy
 
 
 def object_from_footprint(panorama: np.ndarray, footprint: tuple[tuple[float, float], ...], *,
@@ -129,9 +140,65 @@ def _box_solid(box: BoxFit) -> Solid:
     return Solid.prism(box.corners()[:4, :2], float(box.bottom[2]), float(box.size[2]))
 
 
-def _stepped(box: BoxFit, outline: Outline, axis: int) -> ObjectProxy:
+def _carved(proxy: ObjectProxy, parts: np.ndarray, outline: Outline) -> ObjectProxy:
+    """The one-view hull of `outline` in the box or stepped box `proxy` (its `parts`, `silhouette`'s
+    parameters), grown side by side and in height where its silhouette leaves the outline's
+    pixels out, for as long as the agreement gained outweighs the volume added."""
+    shown, directions = outline.cropped()
+    small = dataclasses.replace(outline, shown=shown, directions=directions)
+    wedges = Wedges.of(small)
+    room = outline.room()
+    volume = _volume(parts)
+
+    def score(grow: np.ndarray) -> float:
+        if (grow < 0.0).any():
+            return -1.0
+        boxes = _grown(parts, grow)
+        if room is not None and not all(inside_polygon(_part_footprint(b), room).all() for b in boxes):
+            return -1.0  # through a wall: never taken
+        base = np.logical_or.reduce([silhouette(b, directions, outline.camera) for b in boxes])
+        return agreement(wedges.shown & base, shown) - _GROWTH_COST * (_volume(boxes) / volume - 1.0)
+
+    start = np.zeros(5)
+    grow, _ = climb(score, start, score(start), _GROW_MOVES, budget=_GROW_BUDGET)
+    boxes = _grown(parts, grow)
+    hull = carve(small, wedges, boxes)
+    if hull is None:
+        return proxy
+    fitted = agreement(traced(hull, small), shown)
+    turn = boxes[0, 5]
+    frame = np.array([[np.cos(turn), np.sin(turn), 0.0], [-np.sin(turn), np.cos(turn), 0.0], [0.0, 0.0, 1.0]])
+    size = np.ptp(hull.vertices @ frame.T, axis=0)
+    details = {"base": proxy.kind, "base_size_m": np.round(proxy.size, 4).tolist(),
+               "base_grown_m": np.round(grow[:4], 4).tolist(), "base_heights_scaled": round(float(np.exp(grow[4])), 3),
+               "triangles": len(hull.triangles), "base_agreement": round(proxy.agreement, 4),
+               "box_agreement": proxy.details.get("box_agreement", round(proxy.agreement, 4))}
+    return ObjectProxy(hull, f"carved {proxy.kind}", size, fitted, proxy.outline_pixels, details)
+
+
+def _grown(parts: np.ndarray, grow: np.ndarray) -> np.ndarray:
+    """The parts (side by side, one turn) with the sides on their union's outline moved out by
+    `grow[:4]` metres (width's low and high side, depth's low and high side) and every height
+    scaled by exp(`grow[4]`)."""
+    turn = parts[0, 5]
+    axes = np.array([[np.cos(turn), np.sin(turn)], [-np.sin(turn), np.cos(turn)]])
+    centre = parts[:, :2] @ axes.T
+    half = 0.5 * np.exp(parts[:, 2:4])
+    low, high = centre - half, centre + half
+    low = low - np.where(low <= low.min(axis=0) + 1e-9, grow[[0, 2]], 0.0)
+    high = high + np.where(high >= high.max(axis=0) - 1e-9, grow[[1, 3]], 0.0)
+    return np.column_stack([(0.5 * (low + high)) @ axes, np.log(high - low), parts[:, 4] + grow[4],
+                            np.full(len(parts), turn)])
+
+
+def _volume(parts: np.ndarray) -> float:
+    return float(np.exp(parts[:, 2:5].sum(axis=1)).sum())
+
+
+def _stepped(box: BoxFit, outline: Outline, axis: int) -> tuple[ObjectProxy, np.ndarray]:
     """`box` cut across its width (`axis` 0) or depth (1) into two parts of their own heights,
-    searched with the cut, place, sizes and turn for the best agreement with `outline`."""
+    searched with the cut, place, sizes and turn for the best agreement with `outline`; with
+    its parts (`silhouette`'s parameters)."""
     shown, directions = outline.cropped()
     room = outline.room()
     probe = outline.probe
@@ -151,8 +218,8 @@ def _stepped(box: BoxFit, outline: Outline, axis: int) -> ObjectProxy:
                "size_m": np.round(size, 4).tolist(), "turn_deg": round(float(np.degrees(turn)), 2),
                "steps_along": ("width", "depth")[axis], "step_share": round(_share(cut), 3),
                "step_heights_m": np.round(np.exp([low, high]), 4).tolist()}
-    return ObjectProxy(_step_solid(params, axis, probe, outline.floor_z), "stepped box", size, fitted,
-                       int(outline.shown.sum()), details)
+    return (ObjectProxy(_step_solid(params, axis, probe, outline.floor_z), "stepped box", size, fitted,
+                        int(outline.shown.sum()), details), np.array(_parts(params, axis)))
 
 
 def _share(cut: float) -> float:
