@@ -73,12 +73,13 @@ def _pairs(rel: np.ndarray, n: np.ndarray, sender_normals: np.ndarray | None, ep
     whole = some & above.all(axis=1)
     part = some & ~whole
     f = np.zeros(len(rel))
-    centre = rel.mean(axis=1)
-    reach2 = ((rel - centre[:, None, :]) ** 2).sum(axis=2).max(axis=1)
-    far = whole & (np.einsum("pc,pc->p", centre, centre) > FAR**2 * reach2)
-    f[far] = _midpoints(rel[far], n[far])
-    whole &= ~far
-    f[whole] = _contour(_unit(rel[whole]), n[whole])
+    whole = np.flatnonzero(whole)
+    rel_w = rel[whole]
+    centre = rel_w.mean(axis=1)
+    reach2 = ((rel_w - centre[:, None, :]) ** 2).sum(axis=2).max(axis=1)
+    far = np.einsum("pc,pc->p", centre, centre) > FAR**2 * reach2
+    f[whole[far]] = _midpoints(rel_w[far], n[whole[far]])
+    f[whole[~far]] = _contour(_unit(rel_w[~far]), n[whole[~far]])
     if part.any():
         f[part] = _clip_and_integrate(rel[part], n[part], eps)
     return f

@@ -57,8 +57,8 @@ def cell_shadows(points: np.ndarray, normals: np.ndarray, usable: np.ndarray, gr
                  cell: int) -> CellShadows:
     """The shadows of the significant pairs (receiving rows `rows`, senders `senders`): at the
     points with pairs, exact or from their cells of `cell` pixels on `grid` (None, or a cell of
-    1: all exact). Corners must be `usable` (N,) rows; `budget` (N,) is the luminance a corner's
-    interpolation may get wrong."""
+    1: all exact). Corners must be `usable` (N,) rows; `budget` (N,) is the luminance a
+    corner's interpolation may get wrong."""
     n = len(points)
     e, de = np.zeros((n, 3)), np.zeros((n, 3))
     interpolated = np.zeros(n, dtype=bool)
@@ -67,10 +67,11 @@ def cell_shadows(points: np.ndarray, normals: np.ndarray, usable: np.ndarray, gr
         served, corner_e, corner_de, corner_pairs = _smooth_cells(points, normals, usable, grid, rows, senders,
                                                                   budget, shadow, cell)
         exact_pairs += corner_pairs
-        if len(served.rows):
-            e[served.rows] = np.einsum("nk,nkc->nc", served.weights, corner_e[served.cell])
-            de[served.rows] = np.einsum("nk,nkc->nc", served.weights, corner_de[served.cell])
-            interpolated[served.rows] = True
+        e[served.rows] = np.einsum("nk,nkc->nc", served.weights, corner_e[served.cell])
+        de[served.rows] = np.einsum("nk,nkc->nc", served.weights, corner_de[served.cell])
+        interpolated[served.rows] = True
+    # A cell whose corners disagree is not split further: what made them disagree (the shadow
+    # of a chair's leg, a few pixels wide) would pass between the corners of smaller cells.
     own = ~interpolated[rows]
     add_e, add_de = shadow(rows[own], senders[own])
     e += _sum_rows(rows[own], add_e, n)
@@ -97,7 +98,14 @@ def _smooth_cells(points: np.ndarray, normals: np.ndarray, usable: np.ndarray, g
     r, c = np.divmod(grid.flat, grid.width)
     cols = -(-grid.width // cell)
     key = (r // cell) * cols + c // cell  # (N,) each point's cell
-    cells, cell_of = np.unique(key[rows], return_inverse=True)
+    # Which senders are significant somewhere in each cell, on a table of every cell: sorting
+    # the millions of pairs of a window-lit room would cost more than the rest.
+    present = np.flatnonzero(np.bincount(senders))
+    column = np.zeros(present[-1] + 1, dtype=np.int64)
+    column[present] = np.arange(len(present))
+    table = np.zeros((-(-grid.height // cell) * cols, len(present)), dtype=bool)
+    table[key[rows], column[senders]] = True
+    cells = np.flatnonzero(table.any(axis=1))
     # The cell's corner pixels, wrapping around in longitude; a cell past the last row has none.
     r0, c0 = (cells // cols) * cell, (cells % cols) * cell
     r1, c1 = r0 + cell, (c0 + cell) % grid.width
@@ -110,13 +118,11 @@ def _smooth_cells(points: np.ndarray, normals: np.ndarray, usable: np.ndarray, g
     ok &= usable[corner].all(axis=1)
 
     # Every sender significant somewhere in a cell is taken at all four of its corners.
-    pair = np.unique(cell_of * (senders.max() + 1) + senders)
-    pair_cell, pair_sender = np.divmod(pair, senders.max() + 1)
-    keep = ok[pair_cell]
-    pair_cell, pair_sender = pair_cell[keep], pair_sender[keep]
+    pair_cell, pair_column = np.nonzero(table[cells[ok]])
+    pair_cell = np.flatnonzero(ok)[pair_cell]
     at = corner[pair_cell]  # (m, 4)
-    unique, inverse = np.unique(at * (senders.max() + 1) + pair_sender[:, None], return_inverse=True)
-    u_e, u_de = shadow(unique // (senders.max() + 1), unique % (senders.max() + 1))
+    unique, inverse = np.unique(at * len(present) + pair_column[:, None], return_inverse=True)
+    u_e, u_de = shadow(unique // len(present), present[unique % len(present)])
     inverse = inverse.reshape(-1, 4)
     spread = np.maximum(np.ptp(u_e[inverse] @ LUMA, axis=1), np.ptp(u_de[inverse] @ LUMA, axis=1))
     spread_cell = np.bincount(pair_cell, spread, minlength=len(cells))

@@ -16,10 +16,11 @@ from addon.callbacks import NO_CALLBACKS, RunCallbacks
 from addon.errors import Cancelled, DimredError
 from addon.light.radiosity import LUMA, RHO_MAX
 from addon.quality import params_for
-from addon.removal import finish, solve_lighting
+from addon.removal import finish, irradiance, solve_lighting
 from addon.removal.compose import compose
 from addon.removal.fill import fill_hidden, hidden_light, working_revealed
 from addon.removal.first_order import first_order
+from addon.removal.interpolation import interpolate
 from addon.removal.lit_room import LitRoom
 from addon.removal.local import local_light
 from addon.removal.occlusion import occluders
@@ -174,6 +175,24 @@ def test_local_light_brightens_the_shadowed_floor_pixels_and_leaves_e_positive(s
     assert (local.e_h[floor] @ LUMA > 0).all()
     assert (local.de_h[floor] @ LUMA).max() > 0.1 * np.median(local.e_h[floor] @ LUMA)
     assert stages["rep"].info["exact_pairs"] > 0
+
+
+def test_the_fine_lattice_is_coarser_far_from_the_object_and_agrees_with_the_fine_one_there(stages):
+    lit, traced, target = stages["lit"], stages["traced"], stages["target"]
+    floor = np.flatnonzero(_floor_pixels(stages) & ~traced.hidden_h)
+    distance = np.linalg.norm(traced.points_h[floor] - target.centre, axis=1) / target.radius
+    far = floor[(distance > irradiance.FAR_RADII) & (distance < 3.0)]
+    tri, bary = traced.tri_h[far], traced.hits.bary.reshape(-1, 2)[traced.hp[far]]
+    graded = irradiance.fine_light(lit, tri, bary, NO_CALLBACKS)
+    # With a radius ten times larger every point is near: the fine lattice everywhere.
+    uniform = irradiance.fine_light(dataclasses.replace(lit, target=dataclasses.replace(
+        target, radius=target.radius * 10.0)), tri, bary, NO_CALLBACKS)
+    assert len(graded.t_with) < len(uniform.t_with)
+    e_graded = interpolate(graded.e, graded.corners, graded.weights) @ LUMA
+    e_uniform = interpolate(uniform.e, uniform.corners, uniform.weights) @ LUMA
+    # The lattices' own E (before the lamp's exact shadows replace its share per pixel).
+    off = np.abs(e_graded / e_uniform - 1.0)
+    assert off.mean() < 0.01 and off.max() < 0.05
 
 
 def test_compose_changes_only_pixels_that_keep_their_surface(stages):
