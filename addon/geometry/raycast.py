@@ -33,9 +33,10 @@ class PanoramaHits:
         return self.directions * self.distance[..., None]
 
 
-def _uv_window(tris: np.ndarray, width: int, height: int) -> tuple[np.ndarray, ...]:
+def _uv_window(tris: np.ndarray, edge_normals: np.ndarray, width: int, height: int) -> tuple[np.ndarray, ...]:
     """Pixel windows (row0, rows, col0, cols) holding the centres of every pixel that
-    triangles seen from the origin may cover; rows or cols 0 where they cover none.
+    triangles seen from the origin (with their `_edge_normals`) may cover; rows or cols 0
+    where they cover none.
 
     The bounds are exact, widened by `_MARGIN` pixel: an edge seen from the origin is an arc of a
     great circle, shorter than half of it, along which the elevation has at most one extreme
@@ -54,12 +55,9 @@ def _uv_window(tris: np.ndarray, width: int, height: int) -> tuple[np.ndarray, .
     col0 = np.ceil(start - 0.5 - _MARGIN).astype(np.int64)
     cols = np.floor(start + (1.0 - gaps.max(axis=1)) * width - 0.5 + _MARGIN).astype(np.int64) - col0 + 1
     # A triangle around a pole covers every column near that pole.
-    for pole, edge_row in ((np.array([0.0, 0.0, 1.0]), 0), (np.array([0.0, 0.0, -1.0]), height - 1)):
-        inside = _inside(tris, pole[None, :])[:, 0]
-        row0 = np.where(inside & (edge_row == 0), 0, row0)
-        row1 = np.where(inside & (edge_row == height - 1), height - 1, row1)
-        col0 = np.where(inside, 0, col0)
-        cols = np.where(inside, width, cols)
+    north, south = (edge_normals[..., 2] >= 0.0).all(axis=1), (edge_normals[..., 2] <= 0.0).all(axis=1)
+    row0, row1 = np.where(north, 0, row0), np.where(south, height - 1, row1)
+    col0, cols = np.where(north | south, 0, col0), np.where(north | south, width, cols)
     return row0, np.maximum(row1 - row0 + 1, 0), np.mod(col0, width), np.clip(cols, 0, width)
 
 
@@ -89,11 +87,6 @@ def _edge_normals(tris: np.ndarray) -> np.ndarray:
     normals = np.stack([np.cross(b, c), np.cross(c, a), np.cross(a, b)], axis=1)
     sign = np.sign(np.einsum("ij,ij->i", a, np.cross(b, c)))
     return normals * sign[:, None, None]
-
-
-def _inside(tris: np.ndarray, dirs: np.ndarray) -> np.ndarray:
-    """(T, D) whether directions fall inside each triangle's cone from the origin."""
-    return (np.einsum("tkc,dc->tdk", _edge_normals(tris), dirs) >= 0.0).all(axis=2)
 
 
 @dataclass(frozen=True)
@@ -206,15 +199,15 @@ def trace_panorama(triangles: np.ndarray, width: int, height: int, *,
     det = np.einsum("ij,ij->i", triangles[:, 0], np.cross(triangles[:, 1], triangles[:, 2]))
     scale = np.linalg.norm(triangles, axis=2).max(axis=1) ** 3
     seen = np.flatnonzero(np.abs(det) > 1e-12 * scale)  # edge-on triangles cover no pixel centre
-    row0, nrows, col0, ncols = _uv_window(triangles[seen], width, height)
+    edge_normals = np.zeros((len(triangles), 3, 3))
+    edge_normals[seen] = _edge_normals(triangles[seen])
+    row0, nrows, col0, ncols = _uv_window(triangles[seen], edge_normals[seen], width, height)
     # Only the rows inside the window are worth testing.
     row1 = np.minimum(row0 + nrows, row_start + nrows_w)
     row0 = np.maximum(row0, row_start)
     some = np.flatnonzero((row1 > row0) & (ncols > 0))
     windows = _Windows(seen[some], row0[some], (row1 - row0)[some], col0[some], ncols[some]).split(_BATCH_PIXELS)
     normal = np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0])
-    edge_normals = np.zeros((len(triangles), 3, 3))
-    edge_normals[seen] = _edge_normals(triangles[seen])
     planes = (edge_normals, normal, np.einsum("tc,tc->t", normal, triangles[:, 0]))
     for batch in _batches(windows.pixels):
         # In the triangles' order: the earlier batch keeps a tie of depth.
