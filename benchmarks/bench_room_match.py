@@ -62,9 +62,10 @@ NOTES = (
      "out neither straight nor at right angles."),
     ("workshop: no click file. Benches, stands, partitions and machines stand along every wall: the "
      "photograph shows no floor corner and no stretch of a wall's foot."),
-    ("The hotel armchair from one click: the outline stops at the seat's skirt (its dark legs are not in "
-     "it), so the proxy's front stands behind the front legs; the arms' curves and the back's slope are no "
-     "box's, stepped or not."),
+    ("The hotel armchair from one click: the arms' curves and the back's slope are no box's, stepped or not; "
+     "the stepped box, grown to cover the outline and carved by the outline's cone from the probe, shows the "
+     "outline (the carved proxy's agreement is its mesh traced). The outline stops at the seat's skirt (its "
+     "dark legs are not in it): the removal's own segmentation takes the legs in beside the proxy's silhouette."),
 )
 
 
@@ -153,9 +154,11 @@ def _photos() -> Table:
         for item in clicks.objects:
             proxy = object_proxy(panorama, item, click_size=(clicks.width, clicks.height), probe=room.probe,
                                  inside=room.corners)
-            alone = proxy.details.get("box_agreement")
+            alone, base = proxy.details.get("box_agreement"), proxy.details.get("base_agreement")
             proxies.append(f"{item.name}: {proxy.kind} " + " x ".join(f"{v:.2f}" for v in proxy.size)
                            + f" m, agreement {proxy.agreement:.3f}"
+                           + ("" if base is None else f" ({proxy.details['base']} {base:.3f}, "
+                              f"{proxy.details['triangles']} triangles)")
                            + ("" if alone is None else f" (the box alone {alone:.3f})"))
         suggestion = suggest_room(panorama, width=panorama.shape[1], height=panorama.shape[0])
         table.row(name, f"{panorama.shape[1]}x{panorama.shape[0]}", f"{clicks.click_count()} + height",
