@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from addon.geometry import solid
-from addon.roommatch.hull import Wedges, carve, traced
+from addon.roommatch.hull import Wedges, carve, traced, vertical_columns
 from addon.roommatch.object_box import Outline, agreement, silhouette
 from addon.roommatch.object_shapes import object_from_click
 from addon.roommatch.projection import click_directions, project
@@ -42,6 +42,14 @@ def test_the_hull_of_a_box_in_that_box_is_the_box(turned: float) -> None:
     assert _volume(corners) == pytest.approx(0.8 * 0.7 * 0.9, rel=0.03)
     assert agreement(traced(hull, outline), outline.shown) == 1.0
     assert len(hull.triangles) < 3000
+
+
+def test_a_world_tilted_off_the_vertical_is_not_carved() -> None:
+    # Its pixel columns are no vertical half-planes: the hull's sections would not be its pixels'.
+    a = np.radians(10.0)
+    tilted = np.array([[1.0, 0.0, 0.0], [0.0, np.cos(a), -np.sin(a)], [0.0, np.sin(a), np.cos(a)]])
+    assert vertical_columns(_outline(BOX, rotation_z(40.0)))
+    assert not vertical_columns(_outline(BOX, tilted))
 
 
 def test_the_hull_in_a_bigger_box_shows_the_outline_and_is_smaller_than_the_box() -> None:
