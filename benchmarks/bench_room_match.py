@@ -154,10 +154,10 @@ def _photos() -> Table:
         for item in clicks.objects:
             proxy = object_proxy(panorama, item, click_size=(clicks.width, clicks.height), probe=room.probe,
                                  inside=room.corners)
-            alone, base = proxy.details.get("box_agreement"), proxy.details.get("base_agreement")
+            alone, base = proxy.details.get("box_agreement"), proxy.details.get("base")
             proxies.append(f"{item.name}: {proxy.kind} " + " x ".join(f"{v:.2f}" for v in proxy.size)
                            + f" m, agreement {proxy.agreement:.3f}"
-                           + ("" if base is None else f" ({proxy.details['base']} {base:.3f}, "
+                           + ("" if base is None else f" ({base['shape']} {base['agreement']:.3f}, "
                               f"{proxy.details['triangles']} triangles)")
                            + ("" if alone is None else f" (the box alone {alone:.3f})"))
         suggestion = suggest_room(panorama, width=panorama.shape[1], height=panorama.shape[0])

@@ -169,9 +169,10 @@ def _carved(proxy: ObjectProxy, parts: np.ndarray, outline: Outline) -> ObjectPr
     turn = boxes[0, 5]
     frame = np.array([[np.cos(turn), np.sin(turn), 0.0], [-np.sin(turn), np.cos(turn), 0.0], [0.0, 0.0, 1.0]])
     size = np.ptp(hull.vertices @ frame.T, axis=0)
-    details = {"base": proxy.kind, "base_size_m": np.round(proxy.size, 4).tolist(),
-               "base_grown_m": np.round(grow[:4], 4).tolist(), "base_heights_scaled": round(float(np.exp(grow[4])), 3),
-               "triangles": len(hull.triangles), "base_agreement": round(proxy.agreement, 4),
+    fit = {key: value for key, value in proxy.details.items() if key not in ("agreement", "box_agreement")}
+    base = {"shape": proxy.kind, **fit, "agreement": round(proxy.agreement, 4),
+            "grown_m": np.round(grow[:4], 4).tolist(), "heights_scaled": round(float(np.exp(grow[4])), 3)}
+    details = {"base": base, "triangles": len(hull.triangles),
                "box_agreement": proxy.details.get("box_agreement", round(proxy.agreement, 4))}
     return ObjectProxy(hull, f"carved {proxy.kind}", size, fitted, proxy.outline_pixels, details)
 

@@ -79,7 +79,7 @@ def test_an_armchair_with_arms_gets_a_carved_proxy() -> None:
     click = tuple(np.round(project(np.append(centre - 0.1 * along, 0.3 - 1.5), W, H)))
     proxy = object_from_click(panorama, click, click_size=(W, H), probe=PROBE)
     assert proxy.kind.startswith("carved") and proxy.agreement >= 0.95, (proxy.kind, proxy.agreement)
-    assert proxy.details["base_agreement"] < 0.95
+    assert proxy.details["base"]["agreement"] < 0.95
     corners = proxy.solid.triangle_corners()
     assert solid.closed(corners, 1e-5) and len(corners) < 4000
     assert _volume(corners) > 0.0
