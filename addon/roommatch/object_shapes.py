@@ -1,10 +1,13 @@
 """Object from Photo's proxies: from one click, a box, or a stepped box where the outline shows a
-part standing higher than the rest; from the object's contact points, a prism over them.
+part standing higher than the rest, carved to the outline where neither agrees with it; from the
+object's contact points, a prism over them.
 
 One click: the box of `object_box`, then the same box cut in two along its width or its depth,
 each part with its own height and the cut's place searched (an armchair's back behind its seat);
 the stepped box is kept where it agrees with the outline by `_STEP_GAIN` more, so a box stays a
-box. Contact points: clicked where the object meets the floor, in order round it, they give the
+box. Where the one kept agrees below `_CARVE_BELOW` (curved arms, a sloping back), it is grown
+to cover the outline and carved into its one-view hull (`hull`), kept where that agrees by
+`_CARVE_GAIN` more. Contact points: clicked where the object meets the floor, in order round it, they give the
 footprint polygon on the floor; the panorama is segmented from a seed above the footprint and the
 prism's height is the one whose silhouette agrees best with the outline.
 """
@@ -41,10 +44,10 @@ _HEIGHT_BUDGET = 40
 
 @dataclass(frozen=True)
 class ObjectProxy:
-    """A proxy fitted to an object's outline: its solid, its kind ("box", "stepped box" or
-    "footprint prism"), its size (width, depth, height in metres; a footprint's extent along x
-    and y), how well its silhouette agrees with the outline (shared over united pixels), the
-    outline's pixels, and what the kind adds to the summary."""
+    """A proxy fitted to an object's outline: its solid, its kind ("box", "stepped box", "carved
+    box", "carved stepped box" or "footprint prism"), its size (width, depth, height in metres; a
+    footprint's extent along x and y), how well its silhouette agrees with the outline (shared
+    over united pixels), the outline's pixels, and what the kind adds to the summary."""
 
     solid: Solid | Hull
     kind: str
@@ -72,8 +75,9 @@ def object_from_click(panorama: np.ndarray, click: tuple[float, float], *, click
                       probe: np.ndarray, floor_z: float = 0.0, rotation: np.ndarray | None = None,
                       inside: np.ndarray | None = None) -> ObjectProxy:
     """The proxy of the object clicked at `click` (x, y) on a `click_size` (W, H) panorama: its box,
-    or a stepped box where that agrees better with its outline; within the floor polygon `inside`
-    ((n, 2) world) where given. DimredError when the photograph shows no object standing there."""
+    or a stepped box where that agrees better with its outline, carved where neither agrees well;
+    within the floor polygon `inside` ((n, 2) world) where given. DimredError when the photograph
+    shows no object standing there."""
     outline = outline_at(panorama, click, click_size=click_size, probe=probe, floor_z=floor_z, rotation=rotation,
                          inside=inside)
     box = box_in_outline(outline, click)
