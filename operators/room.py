@@ -261,7 +261,8 @@ class DIMRED_OT_object_from_photo(PanoramaClick, bpy.types.Operator):
     bl_description = ("Click inside an object standing on the floor in the Image Editor showing the panorama (or "
                       "the 3D viewport looking from the probe): a box "
                       "proxy is fitted to its outline (place, width, depth, height, turn; stepped in two heights "
-                      "where one part stands higher, an armchair's back) and marked for removal")
+                      "where one part stands higher, an armchair's back; carved to the outline where no box "
+                      "fits it, curved arms) and marked for removal")
     bl_options = {'REGISTER', 'UNDO'}
 
     name: StringProperty(name="Name", description="The new proxy's name", default="Object")
