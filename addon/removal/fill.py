@@ -16,6 +16,7 @@ from ..light.radiosity import LUMA, RHO_MAX
 from ..report import Report
 from ..synthesis.material import Material
 from ..synthesis.plane_fill import FillOptions, HiddenPlane, PanoramaMaps, PanoramaReflectance, fill_surface
+from ..synthesis.surface_edges import SurfaceEdges, SurfacePlane, find_surface_edges
 from ..synthesis.texture import SynthesisParams
 from .interpolation import interpolate
 from .irradiance import fine_light
@@ -34,6 +35,7 @@ class Revealed:
     radiance: np.ndarray  # (K, 3) as photographed
     footprint: np.ndarray  # (K,) the pixel's edge projected on that surface
     panorama: PanoramaReflectance  # the exemplar's source
+    edges: SurfaceEdges | None = None  # the surfaces' edges as the photograph shows them
 
 
 @dataclass(frozen=True)
@@ -117,6 +119,10 @@ def fill_hidden(solution: Solution, revealed: Revealed, light: HiddenLight, rep:
                          "exemplar": got.material.source, "exemplar_share": round(got.material.share, 3),
                          "seconds": round(seconds, 4)})
     rep.info["filled_surfaces"] = surfaces
+    if revealed.edges is not None and revealed.edges.edges:
+        names = {int(k): geo.object_names[geo.tri_object[t]] for k, t in zip(*np.unique(solution.target.surface_key,
+                                                                                       return_index=True), strict=True)}
+        rep.info["surface_edges"] = [edge.describe(names) for edge in revealed.edges.edges]
     return change()
 
 
@@ -142,16 +148,97 @@ def hidden_planes(geo: Geometry, keys: np.ndarray, tri: np.ndarray, points: np.n
 
 
 def working_revealed(solution: Solution) -> Revealed:
-    """The revealed pixels of the working panorama, with its whole reflectance as exemplar."""
+    """The revealed pixels of the working panorama, with its whole reflectance as exemplar; the
+    pixels between a proxy's surface edge and the photograph's (`surface_edges`) on the surface
+    the photograph shows there."""
     traced, behind = solution.traced, solution.traced.behind
     radiance = traced.panorama_rows(solution.hdri)
     pix = traced.hp[behind.revealed]
+    edges = _working_edges(solution)
+    directions = traced.hits.directions.reshape(-1, 3)
+    tri, bary, points = _onto_photographed(edges, solution, directions[pix], behind.tri, behind.bary, behind.points)
     solid = np.broadcast_to(latlong.pixel_solid_angles(traced.width, traced.height),
                             (traced.height, traced.width)).ravel()[pix]
-    footprint = surface_footprint(solid, traced.hits.directions.reshape(-1, 3)[pix],
-                                  solution.geo.normals[behind.tri], behind.distance_without[pix])
-    return Revealed(tri=behind.tri, bary=behind.bary, points=behind.points, radiance=radiance[behind.revealed],
-                    footprint=footprint, panorama=_panorama_reflectance(solution, radiance))
+    footprint = surface_footprint(solid, directions[pix], solution.geo.normals[tri], np.linalg.norm(points, axis=1))
+    return Revealed(tri=tri, bary=bary, points=points, radiance=radiance[behind.revealed], footprint=footprint,
+                    panorama=_panorama_reflectance(solution, radiance, edges), edges=edges)
+
+
+def filled_surfaces(solution: Solution, revealed: Revealed) -> np.ndarray:
+    """(H, W) the surface each working pixel shows once the object is gone as the fill takes it
+    (on the photograph's side of a surface edge: `working_revealed`), -1 for none."""
+    traced = solution.traced
+    surface = revealed.panorama.maps.surface_without.ravel().copy()
+    surface[traced.hp[traced.behind.revealed]] = solution.target.surface_key[revealed.tri]
+    return surface.reshape(traced.height, traced.width)
+
+
+# Pixels past the proxy's edge where a moved pixel takes its new surface's light: beside the corner.
+_ACROSS = 1.5
+
+
+def _working_edges(solution: Solution) -> SurfaceEdges:
+    """The edges between the room's surfaces near the hole as the working panorama shows them."""
+    traced, geo = solution.traced, solution.geo
+    keys = solution.target.surface_key
+    shape = (traced.height, traced.width)
+    shows = np.full(traced.height * traced.width, -1, dtype=np.int64)
+    shows[traced.hp] = keys[traced.tri_h]
+    target = geo.tri_object == solution.target.index
+    planes = {int(keys[t]): SurfacePlane(geo.normals[t], float(geo.normals[t] @ geo.triangles[t, 0]))
+              for t in np.unique(keys, return_index=True)[1] if not target[t]}
+    return find_surface_edges(np.asarray(solution.hdri), shows.reshape(shape),
+                              surfaces_of(keys, traced.behind.tri_without).reshape(shape), traced.hidden_map, planes)
+
+
+def _onto_photographed(edges: SurfaceEdges, solution: Solution, directions: np.ndarray, tri: np.ndarray,
+                       bary: np.ndarray, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The revealed pixels' triangle, barycentric weights and point (unit `directions` (K, 3)),
+    those the photograph shows on another surface than the proxy moved onto it: the point where
+    their ray meets its plane, their light that of its triangle beside the proxy's corner."""
+    keys = solution.target.surface_key
+    moved, near, near_tri, _ = _moved(edges, solution, directions, keys[tri])
+    if not len(moved):
+        return tri, bary, points
+    tri, bary, points = tri.copy(), bary.copy(), points.copy()
+    normal = solution.geo.normals[near_tri]
+    offset = np.einsum("ij,ij->i", normal, solution.geo.triangles[near_tri, 0])
+    points[moved] = directions[moved] * (offset / np.einsum("ij,ij->i", directions[moved], normal))[:, None]
+    tri[moved] = near_tri
+    bary[moved] = _barycentric(near * (offset / np.einsum("ij,ij->i", near, normal))[:, None],
+                               solution.geo.triangles[near_tri])
+    return tri, bary, points
+
+
+def _moved(edges: SurfaceEdges, solution: Solution, directions: np.ndarray, surface: np.ndarray
+           ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Which of the pixels (unit `directions` (K, 3) on `surface` (K,)) the photograph shows on
+    another surface; where that surface's light is found for each (a direction beside the proxy's
+    corner on it), the triangle seen there and its pixel (flat index); only those whose new
+    surface is seen there."""
+    traced = solution.traced
+    moved = np.flatnonzero(edges.assign(directions, surface) != surface)
+    if not len(moved):
+        return moved, np.zeros((0, 3)), moved, moved
+    new = edges.assign(directions[moved], surface[moved])
+    near = edges.across(directions[moved], surface[moved], _ACROSS)
+    row, col = latlong.uv_to_pixel(*latlong.direction_to_uv(near), traced.width, traced.height)
+    pixel = row * traced.width + col
+    near_tri = traced.behind.tri_without[pixel]
+    ok = surfaces_of(solution.target.surface_key, near_tri) == new
+    return moved[ok], near[ok], near_tri[ok], pixel[ok]
+
+
+def _barycentric(points: np.ndarray, triangles: np.ndarray) -> np.ndarray:
+    """(K, 2) weights of vertices 1 and 2 of `triangles` (K, 3, 3) at `points` (K, 3) on their
+    planes, clamped into the triangle."""
+    v0 = triangles[:, 0]
+    e1, e2, q = triangles[:, 1] - v0, triangles[:, 2] - v0, points - v0
+    d11, d12, d22 = (np.einsum("ij,ij->i", a, b) for a, b in ((e1, e1), (e1, e2), (e2, e2)))
+    q1, q2 = np.einsum("ij,ij->i", q, e1), np.einsum("ij,ij->i", q, e2)
+    den = np.maximum(d11 * d22 - d12**2, 1e-30)
+    w = np.clip(np.stack([(d22 * q1 - d12 * q2) / den, (d11 * q2 - d12 * q1) / den], axis=1), 0.0, 1.0)
+    return w / np.maximum(w.sum(axis=1), 1.0)[:, None]
 
 
 def surface_footprint(solid: np.ndarray, directions: np.ndarray, normals: np.ndarray, distance: np.ndarray
@@ -175,10 +262,11 @@ def working_measured(solution: Solution) -> np.ndarray:
     return ~solution.traced.hidden_h & ~solution.room.pixels.emitter_h & ((e_h @ LUMA) > 1e-3 * e_ref)
 
 
-def _panorama_reflectance(solution: Solution, radiance: np.ndarray) -> PanoramaReflectance:
+def _panorama_reflectance(solution: Solution, radiance: np.ndarray, edges: SurfaceEdges) -> PanoramaReflectance:
     """rho = pi L / E wherever a pixel measures it (not hidden, not a light, not too dark), from
     the hit pixels' radiance L (N, 3); and the surfaces every pixel sees with the object and
-    without it."""
+    without it. Pixels the photograph shows on the other side of a surface edge (`edges`) than
+    the proxy are on that surface, their E that of the surface beside the proxy's corner."""
     traced, e_h = solution.traced, solution.e_h
     keys = solution.target.surface_key
     n = traced.height * traced.width
@@ -186,11 +274,27 @@ def _panorama_reflectance(solution: Solution, radiance: np.ndarray) -> PanoramaR
     surface_with = np.full(n, -1, dtype=np.int64)
     surface_with[traced.hp] = keys[traced.tri_h]
     surface_without = surfaces_of(keys, traced.behind.tri_without)
-    maps = PanoramaMaps(surface_with.reshape(shape), traced.hits.distance, surface_without.reshape(shape),
-                        traced.behind.distance_without.reshape(shape), traced.hidden_map)
+    distance_with = traced.hits.distance.ravel().copy()
+    distance_without = traced.behind.distance_without.copy()
     measured = working_measured(solution)
     rho = np.zeros((n, 3))
     rho[traced.hp] = measured_reflectance(radiance, e_h, measured)
     valid = np.zeros(n, dtype=bool)
     valid[traced.hp[measured]] = True
+    seen = np.flatnonzero(~traced.hidden_h)
+    directions = traced.hits.directions.reshape(-1, 3)[traced.hp[seen]]
+    moved, _, near_tri, near_pixel = _moved(edges, solution, directions, keys[traced.tri_h[seen]])
+    hit_row = np.full(n, -1, dtype=np.int64)
+    hit_row[traced.hp] = np.arange(len(traced.hp))
+    lit = hit_row[near_pixel]
+    ok = (lit >= 0) & measured[np.maximum(lit, 0)] & measured[seen[moved]]
+    rows, lit, near_tri = seen[moved[ok]], lit[ok], near_tri[ok]
+    pixel = traced.hp[rows]
+    surface_with[pixel] = surface_without[pixel] = keys[near_tri]
+    normal = solution.geo.normals[near_tri]
+    offset = np.einsum("ij,ij->i", normal, solution.geo.triangles[near_tri, 0])
+    distance_with[pixel] = distance_without[pixel] = offset / np.einsum("ij,ij->i", directions[moved[ok]], normal)
+    rho[pixel] = measured_reflectance(radiance[rows], e_h[lit], np.ones(len(rows), dtype=bool))
+    maps = PanoramaMaps(surface_with.reshape(shape), distance_with.reshape(shape), surface_without.reshape(shape),
+                        distance_without.reshape(shape), traced.hidden_map)
     return PanoramaReflectance(rho.reshape(*shape, 3), valid.reshape(shape), maps)

@@ -16,14 +16,14 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..callbacks import NO_CALLBACKS, RunCallbacks
-from ..geometry.mesh import Geometry, build_geometry, surfaces_of
+from ..geometry.mesh import Geometry, build_geometry
 from ..quality import Params
 from ..report import Report
 from ..scene import SceneData
 from ..segmentation.seen import SeenObject, seen_object
 from ..segmentation.user_mask import UserMask
 from .compose import compose
-from .fill import fill_hidden, hidden_light, working_measured, working_revealed
+from .fill import fill_hidden, filled_surfaces, hidden_light, working_measured, working_revealed
 from .first_order import first_order
 from .full_resolution import full_resolution
 from .lit_room import LitRoom
@@ -141,8 +141,8 @@ def finish(solution: Solution, rep: Report, callbacks: RunCallbacks = NO_CALLBAC
             light = hidden_light(solution, found, callbacks)
         with rep.stage("synthesis"):
             # the seam is the fill's last step: it stays within the stages a removal reports
-            difference = _seamless(solution, difference_image(fill_hidden(solution, found, light, rep, callbacks,
-                                                                          show)))
+            difference = _seamless(solution, filled_surfaces(solution, found),
+                                   difference_image(fill_hidden(solution, found, light, rep, callbacks, show)))
     else:
         difference = difference_image(np.zeros((0, 3)))
         rep.skip("synthesis", "the object is not visible from the probe centre: no hidden region to fill"
@@ -203,14 +203,13 @@ def _quiet_working(solution: Solution, d_h: np.ndarray, rep: Report) -> np.ndarr
     return quiet.change.reshape(-1, 3)[traced.hp]
 
 
-def _seamless(solution: Solution, difference: np.ndarray) -> np.ndarray:
+def _seamless(solution: Solution, surface: np.ndarray, difference: np.ndarray) -> np.ndarray:
     """The working panorama's `difference` (H, W, 3) with the filled pixels' step against the
-    relit photograph around them taken out (`seam`)."""
+    relit photograph around them taken out (`seam`), per `surface` (H, W) as the fill took them."""
     traced = solution.traced
     shape = (traced.height, traced.width)
     filled = np.zeros(traced.height * traced.width, dtype=bool)
     filled[traced.hp[traced.behind.revealed]] = True
-    surface = surfaces_of(solution.target.surface_key, traced.behind.tri_without).reshape(shape)
     return seamless_panorama_change(np.asarray(solution.hdri, np.float32), difference, filled.reshape(shape), surface)
 
 
