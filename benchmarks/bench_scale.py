@@ -244,18 +244,35 @@ def _cells(preset: Preset, engine: bool, case: Case, run: Measured, base: Measur
     if run.status:
         tail = (run.out.parent / "log.txt").read_text().strip().splitlines() or ["no output"]
         return [*head, str(triangles), f"failed ({run.status}): {tail[-1]}", "", "", "", "", ""]
-    stages = json.loads((run.out / "report.json").read_text())["seconds"]
-    if not engine:
-        # The report is written with the results, so its seconds end before they do: the
-        # writing is the command's own total ("removed ... in T s") less the report's.
-        said = re.search(r" in ([0-9.]+) s; wrote", (run.out.parent / "log.txt").read_text())
-        if said:
-            stages["write"] = float(said.group(1)) - stages["total"]
+    stages = _stages(run, engine)
     slowest = sorted(((v, k) for k, v in stages.items() if k not in ("total", "read_scene")), reverse=True)[:3]
     ok = not base.status
     return [*head, str(triangles), f"{run.seconds:.1f}", f"{run.seconds / base.seconds:.2f}" if ok else "",
             f"{run.peak_gb:.2f}", f"{run.peak_gb / base.peak_gb:.2f}" if ok else "", _error(case, run, engine),
             ", ".join(f"{k} {v:.1f}" for v, k in slowest)]
+
+
+def _stages(run: Measured, engine: bool) -> dict[str, float]:
+    """The run's report's seconds per stage, in the order they ran; on the command line with the
+    writing of the results, which the report's own seconds end before: the command's total
+    ("removed ... in T s") less the report's."""
+    stages = json.loads((run.out / "report.json").read_text())["seconds"]
+    said = None if engine else re.search(r" in ([0-9.]+) s; wrote", (run.out.parent / "log.txt").read_text())
+    if said:
+        stages["write"] = float(said.group(1)) - stages["total"]
+    return stages
+
+
+def _profile(label: str, case: Case, run: Measured, engine: bool) -> str:
+    """One line: every stage of the run of `case`, and what the process spent besides."""
+    if run.status:
+        return f"{label} at {case.width}x{case.width // 2} failed."
+    stages = _stages(run, engine)
+    counted = sum(v for k, v in stages.items() if k != "total")
+    # The scene is read first, though the command line adds its seconds to the report last.
+    parts = [f"{k} {stages[k]:.1f}" for k in sorted(stages, key=lambda k: k != "read_scene") if k != "total"]
+    return (f"Every stage of {label} at {case.width}x{case.width // 2} (s): {', '.join(parts)}; the process's "
+            f"start and the rest {run.seconds - counted:.1f}.")
 
 
 def _floor(case: Case) -> str:
@@ -319,7 +336,8 @@ def main() -> None:
     cases = _cases(args)
     pair = cases[0].pair
     floor = metrics.noise_floor(read_exr(pair["input"]), read_exr(pair["truth"]), np.load(pair["mask"]))
-    rows = []
+    rows, profiles = [], []
+    widest = max(cases, key=lambda c: (c.width, -c.split))
     with tempfile.TemporaryDirectory() as folder:
         widths = _ints(args.working_widths) or [None]
         for preset in [(quality, w) for quality in args.quality.split(",") for w in widths]:
@@ -328,12 +346,14 @@ def main() -> None:
                 run = base if case is cases[0] else _run(case, name, preset, args.engine, Path(folder))
                 rows.append(_cells(preset, args.engine, case, run, base))
                 print(" | ".join(rows[-1]), file=sys.stderr, flush=True)
+                if case is widest:
+                    profiles.append(_profile(rows[-1][0], case, run, args.engine))
     table = Table(COLUMNS, title=f"scene {args.scene} rendered {args.width}x{args.width // 2} @ {args.samples} spp; "
                                  f"noise floor {floor:.3f}; seconds: process wall time; peak memory: its maximum "
                                  "resident set")
     for row in rows:
         table.row(*row)
-    write(table, notes=[f"The floor to compare against: {_floor(max(cases, key=lambda c: c.width))}."])
+    write(table, notes=[*profiles, f"The floor to compare against: {_floor(widest)}."])
 
 
 if __name__ == "__main__":

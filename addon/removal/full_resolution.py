@@ -189,10 +189,10 @@ def _upsample(solution: Solution, maps: WorkingMaps, canvas: _Canvas, rep: Repor
             return left
 
         e, de = bilinear(e_map).reshape(-1, 3), bilinear(de_map).reshape(-1, 3)
-        plain = grid.plain[pair][:, col].ravel()
-        cell_spread = grid.spread[pair][:, col].ravel()
+        plain = np.take(grid.plain[pair], col, axis=1).ravel()
+        cell_spread = np.take(grid.spread[pair], col, axis=1).ravel()
         sharp = plain & (cell_spread > _SHARP)
-        cell_key = maps.key[(top[pair] * maps.width)[:, None] + col[None, :]].ravel()
+        cell_key = np.take(maps.key.reshape(maps.height, maps.width)[top[pair]], col, axis=1).ravel()
         pixels = _BandPixels.of(rows, width, window, solution.target.surface_key)
         # The pixels the cells cannot serve as they are: those of a mixed cell, and in the
         # window those hidden, beside the object or on another surface than their cell's.
