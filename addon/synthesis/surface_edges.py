@@ -38,7 +38,9 @@ _PROMINENCE = 3.0  # the best step against the median candidate's: below it the 
 # Below this step (log radiance, about 10 %) the two sides differ too little for the wrong
 # surface's texture to show: no edge is taken, the proxy's is kept.
 _MIN_STEP = 0.1
-_MAX_SLOPE = 0.2  # pixels of offset per pixel along the edge: the photograph's edge turned by up to 11 degrees
+_MAX_SLOPE = 0.1  # pixels of offset per pixel along the edge: the photograph's edge turned by up to 6 degrees
+# The proxy's own line is the prior: another is taken only where it steps this many times more.
+_OVER_PROXY = 2.0
 _BESIDE = 0.3  # the stretch measured: the hole's along the edge and this share of it on either side
 _MIN_ADJACENT = 3  # pixel pairs across which two surfaces must meet near the hole to count as an edge
 
@@ -239,9 +241,10 @@ def _strongest_step(offset: np.ndarray, position: np.ndarray, along: np.ndarray,
     (N, C) step most consistently: the step between the mean colours of a band on either side,
     per segment along the edge (`along`, pixels), averaged as vectors over the segments so that
     steps of one sign and colour all along add up and a desk's or a rug's edge in one segment
-    does not. None where the best stands out of the typical candidate's by less than
-    `_PROMINENCE`, steps less than `_MIN_STEP`, lies at the search range's end, or too few
-    segments see both bands."""
+    does not. The proxy's own line (0, 0) where none steps `_OVER_PROXY` times more than it; None
+    where the proxy's line is not seen in enough segments, or where the edge found steps less
+    than `_PROMINENCE` times the typical candidate or `_MIN_STEP`, or lies at the search range's
+    end."""
     if not len(offset):
         return None
     bands = round(_BAND / _BIN)
@@ -254,6 +257,7 @@ def _strongest_step(offset: np.ndarray, position: np.ndarray, along: np.ndarray,
     lines = (e - half) * _BIN
     search = np.abs(lines) <= _SEARCH
     scores = np.zeros((len(slopes), len(e)))
+    proxy_seen = False
     for i, slope in enumerate(slopes):
         moved = offset - slope * position
         keep = np.abs(moved) < _SEARCH + _BAND
@@ -269,10 +273,17 @@ def _strongest_step(offset: np.ndarray, position: np.ndarray, along: np.ndarray,
         segments = both.sum(axis=0)
         mean = step.sum(axis=0) / np.maximum(segments, 1)[:, None]
         scores[i] = np.where((segments >= _MIN_SEGMENTS) & search, np.linalg.norm(mean, axis=-1), 0.0)
+        if slope == 0.0:  # the proxy's own line
+            proxy_seen = segments[np.argmin(np.abs(lines))] >= _MIN_SEGMENTS
     if not (scores > 0).any():
         return None
     i, j = np.unravel_index(int(np.argmax(scores)), scores.shape)
-    if (scores[i, j] < max(_PROMINENCE * float(np.median(scores[scores > 0])), _MIN_STEP)
-            or abs(lines[j]) >= _SEARCH):
+    proxy = scores[len(slopes) // 2, np.argmin(np.abs(lines))]
+    edge = max(_PROMINENCE * float(np.median(scores[scores > 0])), _MIN_STEP)
+    if not proxy_seen:
+        return None
+    if scores[i, j] < _OVER_PROXY * proxy:
+        return (0.0, 0.0) if proxy >= edge else None
+    if scores[i, j] < edge or abs(lines[j]) >= _SEARCH:
         return None
     return float(lines[j]), float(slopes[i])
