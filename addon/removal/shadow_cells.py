@@ -6,12 +6,14 @@ significant at most pixels but changes slowly from pixel to pixel, so computing 
 pairs costs what the window's area costs, not what the shadow's detail needs. A cell's corners
 get the exact shadow of every sender significant anywhere in the cell; where the spread of
 those corner values, summed over the senders, stays under the budget of each corner (a share
-of its light), every pixel of the cell on the corners' plane takes the bilinear mix of them.
-Elsewhere (the shadow's sharp edge, the object's outline, a change of surface, a corner hidden
-behind the object) each pixel gets its own. As the exact values inside a smooth cell lie
-between its corners', the spread bounds what the mix gets wrong; a feature of the object
-narrower than a cell whose shadow passes between all four corners breaks that, so the cell is
-kept to a few pixels, narrower than the legs of the furniture it meets.
+of its light), or where the mix of the corners gets the cell's middle pixel right to within
+it (a gradient, as in a window's broad penumbra), every pixel of the cell on the corners'
+plane takes the bilinear mix of them. Elsewhere (the shadow's sharp edge, the object's
+outline, a change of surface, a corner hidden behind the object) each pixel gets its own. As
+the exact values inside a smooth cell lie between its corners' or follow their gradient, the
+spread or the middle's miss bounds what the mix gets wrong; a feature of the object narrower
+than a cell whose shadow passes between its corners and its middle breaks that, so the cell
+is kept to a few pixels, narrower than the legs of the furniture it meets.
 """
 from __future__ import annotations
 
@@ -91,8 +93,9 @@ class _Served:
 def _smooth_cells(points: np.ndarray, normals: np.ndarray, usable: np.ndarray, grid: PixelGrid, rows: np.ndarray,
                   senders: np.ndarray, budget: np.ndarray, shadow: PairShadow, cell: int
                   ) -> tuple[_Served, np.ndarray, np.ndarray, int]:
-    """The points served by cells whose corners agree, the summed shadow (C, 4, 3) at each
-    cell's corners for E and for dE, and the pairs computed at corners."""
+    """The points served by cells whose corners agree, or whose middle the corners' mix gets
+    right, the summed shadow (C, 4, 3) at each cell's corners for E and for dE, and the pairs
+    computed at corners and middles."""
     row_of = np.full(grid.height * grid.width, -1)
     row_of[grid.flat] = np.arange(len(grid.flat))
     r, c = np.divmod(grid.flat, grid.width)
@@ -125,8 +128,18 @@ def _smooth_cells(points: np.ndarray, normals: np.ndarray, usable: np.ndarray, g
     u_e, u_de = shadow(unique // len(present), present[unique % len(present)])
     inverse = inverse.reshape(-1, 4)
     spread = np.maximum(np.ptp(u_e[inverse] @ LUMA, axis=1), np.ptp(u_de[inverse] @ LUMA, axis=1))
-    spread_cell = np.bincount(pair_cell, spread, minlength=len(cells))
-    smooth = ok & (spread_cell <= budget[corner].min(axis=1))
+    allowed = budget[corner].min(axis=1)
+    smooth = ok & (np.bincount(pair_cell, spread, minlength=len(cells)) <= allowed)
+    # Corners that differ more may still hold a gradient, which the mix follows: the cell's
+    # middle pixel tells it from a shadow's edge or a bend, where the mix misses the middle.
+    middle = row_of[(r0 + cell // 2) * grid.width + (c0 + cell // 2) % grid.width]
+    ask = ok & ~smooth & (middle >= 0)
+    ask[ask] = usable[middle[ask]] & _on_plane(points, normals, middle[ask], corner[ask])
+    asked = ask[pair_cell]
+    m_e, m_de = shadow(middle[pair_cell[asked]], present[pair_column[asked]])
+    missed_e = _sum_rows(pair_cell[asked], u_e[inverse[asked]].mean(axis=1) - m_e, len(cells)) @ LUMA
+    missed_de = _sum_rows(pair_cell[asked], u_de[inverse[asked]].mean(axis=1) - m_de, len(cells)) @ LUMA
+    smooth |= ask & (np.maximum(np.abs(missed_e), np.abs(missed_de)) <= allowed)
     corner_e, corner_de = np.zeros((len(cells), 4, 3)), np.zeros((len(cells), 4, 3))
     for k in range(4):
         corner_e[:, k] = _sum_rows(pair_cell, u_e[inverse[:, k]], len(cells))
@@ -136,15 +149,20 @@ def _smooth_cells(points: np.ndarray, normals: np.ndarray, usable: np.ndarray, g
     p = np.unique(rows)
     p_cell = np.searchsorted(cells, key[p])
     p, p_cell = p[smooth[p_cell]], p_cell[smooth[p_cell]]
-    corners_p = corner[p_cell]
-    facing = np.einsum("nc,nkc->nk", normals[p], normals[corners_p]) >= _SAME_PLANE_COS
-    off = np.abs(np.einsum("nc,nkc->nk", normals[p], points[corners_p] - points[p][:, None, :]))
-    flat = (facing & (off <= _SAME_PLANE_GAP * np.linalg.norm(points[p], axis=1)[:, None])).all(axis=1)
+    flat = _on_plane(points, normals, p, corner[p_cell])
     p, p_cell = p[flat], p_cell[flat]
     fr = (r[p] - r0[p_cell]) / cell
     fc = ((c[p] - c0[p_cell]) % grid.width) / cell
     weights = np.stack([(1 - fr) * (1 - fc), (1 - fr) * fc, fr * (1 - fc), fr * fc], axis=1)
-    return _Served(p, p_cell, weights), corner_e, corner_de, len(unique)
+    return _Served(p, p_cell, weights), corner_e, corner_de, len(unique) + int(asked.sum())
+
+
+def _on_plane(points: np.ndarray, normals: np.ndarray, p: np.ndarray, corners: np.ndarray) -> np.ndarray:
+    """(n,) whether points p (n,) lie on the plane of all their corners (n, 4): same normal, and
+    off each other's plane by a hair of their distance from the probe."""
+    facing = np.einsum("nc,nkc->nk", normals[p], normals[corners]) >= _SAME_PLANE_COS
+    off = np.abs(np.einsum("nc,nkc->nk", normals[p], points[corners] - points[p][:, None, :]))
+    return (facing & (off <= _SAME_PLANE_GAP * np.linalg.norm(points[p], axis=1)[:, None])).all(axis=1)
 
 
 def _sum_rows(rows: np.ndarray, values: np.ndarray, n: int) -> np.ndarray:

@@ -68,6 +68,23 @@ def test_a_sharp_shadow_edge_is_computed_at_its_pixels():
     np.testing.assert_allclose(cells.e, exact.e, atol=1e-12)
 
 
+def test_a_steep_gradient_is_interpolated_where_the_middle_pixel_confirms_it():
+    points, normals, grid = _floor()
+    steep = lambda x, y: 5.0 * x + 3.0 * y  # noqa: E731
+    exact, exact_pairs = _run(points, normals, grid, steep, cell=1)
+    cells, cell_pairs = _run(points, normals, grid, steep, cell=4, budget=1e-6)
+    assert cells.interpolated_points > H * W // 2 and cell_pairs < exact_pairs / 2
+    np.testing.assert_allclose(cells.e, exact.e, atol=1e-9)
+
+
+def test_a_bend_inside_a_cell_is_computed_at_its_pixels():
+    points, normals, grid = _floor()
+    bend = lambda x, y: np.abs(x - 2.2)  # noqa: E731
+    exact, _ = _run(points, normals, grid, bend, cell=1)
+    cells, _ = _run(points, normals, grid, bend, cell=4, budget=1e-6)
+    np.testing.assert_allclose(cells.e, exact.e, atol=1e-9)
+
+
 def test_corners_that_disagree_by_less_than_the_budget_are_interpolated():
     points, normals, grid = _floor()
     step = lambda x, y: np.where(x < 2.05, 0.0, 0.001)  # noqa: E731
