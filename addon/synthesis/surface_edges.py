@@ -41,8 +41,15 @@ _MIN_STEP = 0.1
 _MAX_SLOPE = 0.1  # pixels of offset per pixel along the edge: the photograph's edge turned by up to 6 degrees
 # The proxy's own line is the prior: another is taken only where it steps this many times more.
 _OVER_PROXY = 2.0
+# Nor within this many pixels of it at the hole's middle: a line turned about the hole took a
+# printed wall's texture for the edge on the photo-textured hotel room (an exact proxy).
+_MIN_SHIFT = 2.0
 _BESIDE = 0.3  # the stretch measured: the hole's along the edge and this share of it on either side
 _MIN_ADJACENT = 3  # pixel pairs across which two surfaces must meet near the hole to count as an edge
+# Only a floor's or a ceiling's edges (normal within 25 degrees of the vertical) are looked for: a
+# corner between two walls is a vertical line among many in a photograph (a door's frame, a
+# curtain's edge), which the search took for the corner on the photo-textured hotel room.
+_LEVEL = 0.9
 
 
 @dataclass(frozen=True)
@@ -183,7 +190,7 @@ def find_surface_edges(photo: np.ndarray, shows: np.ndarray, behind: np.ndarray,
 
 def _meeting_pairs(labels: np.ndarray, planes: dict[int, SurfacePlane]) -> list[tuple[int, int]]:
     """The pairs of plane ids (a < b) of `planes` whose pixels in `labels` (h, w) touch, at least
-    `_MIN_ADJACENT` times, their planes not parallel."""
+    `_MIN_ADJACENT` times, one a floor or ceiling and the other not."""
     found = []
     for x, y in ((labels[:-1], labels[1:]), (labels[:, :-1], labels[:, 1:])):
         touch = (x != y) & (x >= 0) & (y >= 0)
@@ -191,7 +198,7 @@ def _meeting_pairs(labels: np.ndarray, planes: dict[int, SurfacePlane]) -> list[
     pairs, counts = np.unique(np.concatenate(found), axis=0, return_counts=True)
     return [(int(a), int(b)) for (a, b), n in zip(pairs, counts, strict=True)
             if n >= _MIN_ADJACENT and a in planes and b in planes
-            and np.linalg.norm(np.cross(planes[a].normal, planes[b].normal)) > 0.1]
+            and (abs(planes[a].normal[2]) > _LEVEL) != (abs(planes[b].normal[2]) > _LEVEL)]
 
 
 def _edge(planes: dict[int, SurfacePlane], a: int, b: int, directions: np.ndarray, log_photo: np.ndarray,
@@ -241,10 +248,10 @@ def _strongest_step(offset: np.ndarray, position: np.ndarray, along: np.ndarray,
     (N, C) step most consistently: the step between the mean colours of a band on either side,
     per segment along the edge (`along`, pixels), averaged as vectors over the segments so that
     steps of one sign and colour all along add up and a desk's or a rug's edge in one segment
-    does not. The proxy's own line (0, 0) where none steps `_OVER_PROXY` times more than it; None
-    where the proxy's line is not seen in enough segments, or where the edge found steps less
-    than `_PROMINENCE` times the typical candidate or `_MIN_STEP`, or lies at the search range's
-    end."""
+    does not. The proxy's own line (0, 0) where none steps `_OVER_PROXY` times more than it or
+    the best lies within `_MIN_SHIFT` of it at the hole's middle; None where the proxy's line is
+    not seen in enough segments, or where the edge found steps less than `_PROMINENCE` times the
+    typical candidate or `_MIN_STEP`, or lies at the search range's end."""
     if not len(offset):
         return None
     bands = round(_BAND / _BIN)
@@ -282,7 +289,7 @@ def _strongest_step(offset: np.ndarray, position: np.ndarray, along: np.ndarray,
     edge = max(_PROMINENCE * float(np.median(scores[scores > 0])), _MIN_STEP)
     if not proxy_seen:
         return None
-    if scores[i, j] < _OVER_PROXY * proxy:
+    if scores[i, j] < _OVER_PROXY * proxy or abs(lines[j]) < _MIN_SHIFT:
         return (0.0, 0.0) if proxy >= edge else None
     if scores[i, j] < edge or abs(lines[j]) >= _SEARCH:
         return None
