@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..light.planner import shadow_volume
+from ..light.planner import in_shadow_volume
 from ..light.radiosity import LUMA
 from ..light.transport import Senders
 from ..quality import Params
@@ -27,9 +27,13 @@ def significant(senders: Senders, imp: np.ndarray, points: np.ndarray, e_points:
     b_y = senders.radiosity[imp] @ LUMA
     tris = senders.triangles[imp]
     area = np.linalg.norm(np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0]), axis=1) / 2
-    # |p - c|^2 expanded: a matrix product instead of an (N, I, 3) array of differences.
-    d2 = np.maximum(np.einsum("ij,ij->i", points, points)[:, None] - 2.0 * points @ imp_c.T
-                    + np.einsum("ij,ij->i", imp_c, imp_c)[None], 0.0) + imp_r[None] ** 2
-    bound = b_y[None] * area[None] / (np.pi * d2)
-    worth = bound >= params.significance * np.maximum(e_points @ LUMA, 1e-30)[:, None]
-    return shadow_volume(points, imp_c, imp_r, target.centre, target.radius + np.asarray(margin), only=worth)
+    # Sender by sender: (N, I) temporaries of a window-lit room's half a million pixels would
+    # cost more in memory traffic than the arithmetic.
+    least = np.pi * params.significance * np.maximum(e_points @ LUMA, 1e-30)
+    obj_radius = np.broadcast_to(target.radius + np.asarray(margin, dtype=np.float64), (len(points),))
+    out = np.zeros((len(points), len(imp)), dtype=bool)
+    for s in range(len(imp)):
+        gap = points - imp_c[s]
+        rows = np.flatnonzero(b_y[s] * area[s] >= least * (np.einsum("ij,ij->i", gap, gap) + imp_r[s] ** 2))
+        out[rows, s] = in_shadow_volume(points[rows], imp_c[s], imp_r[s], target.centre, obj_radius[rows])
+    return out
