@@ -28,8 +28,9 @@ class Params:
     fine_pixels: float = 5.0  # ... and at most this many panorama pixels wide at the object's distance
     reach: float = 0.1  # the object's neighbourhood (fine lattice): where its solid angle exceeds this
     significance: float = 0.01  # shadow of a light computed per pixel where it can change E by this share
-    # ... its visibility traced at the corners of cells this many working pixels wide, and
-    # interpolated inside where they agree to within that share (1: traced at every pixel)
+    # ... computed at the corners of cells at most this many working pixels wide (an eighth of
+    # the object's radius at most) and mixed inside where that is right to within that share
+    # (1: computed at every pixel)
     shadow_cell: int = 4
     bright_factor: float = 4.0  # important senders are this many times brighter than the median patch
     patch_samples: int = 2  # k*k points average the first-order change over patches near the object

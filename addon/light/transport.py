@@ -121,10 +121,12 @@ def form_factors(points: np.ndarray, normals: np.ndarray, senders: Senders) -> n
 
 def pair_visibility(
     points: np.ndarray, senders: Senders, r: np.ndarray, s: np.ndarray, removed: Occluders | None,
-    others: Occluders | None, check: Callable[[], None] | None = None,
+    others: Occluders | None, check: Callable[[], None] | None = None, *, counts: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Visible fractions of sender s[i] from point r[i]: with the removed object, and without it.
-    `check()` is called between chunks (it raises to cancel).
+    `check()` is called between chunks (it raises to cancel). With `counts` (n,), pair i traces
+    only the first counts[i] of its sender's samples in an order that spreads every prefix over
+    the sender (`spread_order`), its weights taken over those.
 
     Only the pairs whose segments can pass the removed object's bounding sphere are traced
     against it (a sender's segments all lie within its samples' sphere of the segment to their
@@ -140,24 +142,39 @@ def pair_visibility(
         m = samples.shape[1]
         centre = samples.mean(axis=1)
         reach = np.sqrt(((samples - centre[:, None, :]) ** 2).sum(axis=2).max(axis=1))
+        rank = np.argsort(spread_order(samples[0]))
         per = max(1, _SEGMENTS_PER_CHUNK // m)
         for i0 in range(0, len(sel), per):
             if check is not None:
                 check()
             k = sel[i0 : i0 + per]
             slot = senders.slot[s[k]]
+            use = np.ones((len(k), m), dtype=bool) if counts is None else rank[None, :] < counts[k, None]
             free = np.ones((len(k), m), dtype=bool)  # by the removed object
             free_without = np.ones((len(k), m), dtype=bool)  # by every other occluder
             if sphere is not None:
-                near = _passes(points[r[k]], centre[slot], reach[slot], *sphere)
-                free[near] = ~_blocked(removed, points[r[k[near]]], samples[slot[near]])
+                near = use & _passes(points[r[k]], centre[slot], reach[slot], *sphere)[:, None]
+                free[near] = ~_blocked(removed, points[r[k]], samples[slot], near)
             if others is not None:
-                free_without = ~_blocked(others, points[r[k]], samples[slot])
-            w = weights[slot]
-            vis[k] = ((free & free_without) * w).sum(axis=1)
-            vis_without[k] = (free_without * w).sum(axis=1)
+                free_without[use] = ~_blocked(others, points[r[k]], samples[slot], use)
+            w = weights[slot] * use
+            total = 1.0 if counts is None else w.sum(axis=1)
+            vis[k] = ((free & free_without) * w).sum(axis=1) / total
+            vis_without[k] = (free_without * w).sum(axis=1) / total
     vis_without = np.where(senders.on_removed[s], 0.0, vis_without)
     return vis, vis_without
+
+
+def spread_order(samples: np.ndarray) -> np.ndarray:
+    """(m,) an order of a sender's m sample points (m, 3) whose every prefix spreads over it:
+    each next one the farthest from those before (from the one nearest their centre)."""
+    gap = np.linalg.norm(samples - samples.mean(axis=0), axis=1)
+    order = [int(np.argmin(gap))]
+    nearest = np.linalg.norm(samples - samples[order[0]], axis=1)
+    for _ in range(len(samples) - 1):
+        order.append(int(np.argmax(nearest)))
+        nearest = np.minimum(nearest, np.linalg.norm(samples - samples[order[-1]], axis=1))
+    return np.array(order)
 
 
 def _sphere(occluders: Occluders) -> tuple[np.ndarray, float]:
@@ -175,10 +192,10 @@ def _passes(points: np.ndarray, ends: np.ndarray, reach: np.ndarray, centre: np.
     return np.einsum("ij,ij->i", gap, gap) <= (radius + reach) ** 2
 
 
-def _blocked(occluders: Occluders, points: np.ndarray, samples: np.ndarray) -> np.ndarray:
-    """(n, m) whether the segments from points (n, 3) to their samples (n, m, 3) are blocked."""
-    n, m = samples.shape[:2]
-    return occluders.blocked(np.repeat(points, m, axis=0), samples.reshape(-1, 3)).reshape(n, m)
+def _blocked(occluders: Occluders, points: np.ndarray, samples: np.ndarray, where: np.ndarray) -> np.ndarray:
+    """Whether the segments from points (n, 3) to their samples (n, m, 3) are blocked, for
+    the entries `where` (n, m) holds."""
+    return occluders.blocked(np.repeat(points, where.sum(axis=1), axis=0), samples[where])
 
 
 def transport(

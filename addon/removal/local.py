@@ -14,6 +14,7 @@ from ..light.radiosity import LUMA
 from ..light.transport import pair_visibility
 from ..quality import Params
 from ..report import Report
+from .emitter_groups import GROUP_SAMPLES, emitter_groups, sample_counts
 from .interpolation import interpolate
 from .irradiance import before_and_after, fine_light, point_light
 from .lit_room import LitRoom
@@ -68,9 +69,12 @@ def local_light(lit: LitRoom, traced: Traced, params: Params, rep: Report, callb
     else:
         rep.info["fine_vertices"] = light.fine_vertices
         rep.info["exact_pairs"] = light.exact_pairs
-        rep.info["shadow_cells"] = {"cell": params.shadow_cell, "tolerance": params.significance,
+        rep.info["shadow_cells"] = {"cell": lit.target.shadow_cell, "tolerance": params.significance,
                                     "interpolated_points": light.interpolated_points,
                                     "computed_pairs": light.computed_pairs}
+        if light.emitters:
+            rep.info["emitter_groups"] = {"patches": list(light.emitters), "rays_per_pixel": GROUP_SAMPLES
+                                          * params.sender_samples**2}
     return LocalLight(light.e, light.de)
 
 
@@ -87,6 +91,7 @@ class PointLight:
     exact_pairs: int
     interpolated_points: int = 0
     computed_pairs: int = 0
+    emitters: tuple[int, ...] = ()  # patches of each emitter of several important senders
 
 
 def light_at(lit: LitRoom, receiving: Receiving, params: Params, callbacks: RunCallbacks, *,
@@ -144,13 +149,16 @@ def light_at(lit: LitRoom, receiving: Receiving, params: Params, callbacks: RunC
         visibility adds to E and dE (each (n, 3))."""
         f = paired_point_to_triangle(receiving.points[pix], receiving.normals[pix], room.senders.triangles[s],
                                      room.senders.normals[s])
+        per_sender = np.array([samples.shape[1] for samples in room.senders.samples])[room.senders.group[s]]
+        counts = sample_counts(groups, pix, s, f * (b[s] @ LUMA), per_sender)
         vis, vis_w = pair_visibility(receiving.points, room.senders, pix, s, lit.occlusion.removed,
-                                     lit.occlusion.others, callbacks.check)
+                                     lit.occlusion.others, callbacks.check, counts=counts)
         return (f * vis - lattice_share(pix, s))[:, None] * b[s], (f * (vis_w - vis))[:, None] * b[s]
 
+    groups = emitter_groups(room.senders, imp)
     pair_row, pair_sender = np.nonzero(sig)
     shadows = cell_shadows(receiving.points, receiving.normals, receiving.relit, receiving.grid,
                            candidate[pair_row], imp[pair_sender], params.significance * np.maximum(e_h @ LUMA, 0.0),
-                           shadow, cell=params.shadow_cell)
+                           shadow, cell=target.shadow_cell)
     return PointLight(e_h + shadows.e, de_h + shadows.de, affected, fine_vertices, len(pair_row),
-                      shadows.interpolated_points, shadows.exact_pairs)
+                      shadows.interpolated_points, shadows.exact_pairs, tuple(groups.sizes[groups.sizes > 1].tolist()))

@@ -11,6 +11,9 @@ from ..quality import Params
 from ..report import Report
 from ..scene import SceneData
 
+#: The object's radius spans at least this many shadow cells.
+SHADOW_CELLS_PER_RADIUS = 8
+
 
 @dataclass(frozen=True)
 class Target:
@@ -21,6 +24,7 @@ class Target:
     centre: np.ndarray  # (3,) centre of its bounding sphere, probe frame
     radius: float  # radius of its bounding sphere
     fine_cell: float  # cell of the fine lattice near it
+    shadow_cell: int  # pixels a cell of its shadows spans (`shadow_cells`), 1: every pixel computed
     eps: float  # length tolerance of the ray tests
     surface_key: np.ndarray  # (T,) the plane each triangle lies in (`geometry.mesh.surface_keys`)
 
@@ -43,8 +47,11 @@ def prepare(scene: SceneData, object_name: str, planes: list[str] | tuple[str, .
     height = scene.hdri.shape[0]
     pixel = float(np.linalg.norm(centre)) * np.pi / height
     fine_cell = min(radius / params.fine_cells, params.fine_pixels * pixel)
+    # A shadow cell must stay narrower than the object's legs and slats, a tenth of its size or
+    # so: an object a few dozen pixels across has every pixel's shadow computed.
+    shadow_cell = int(np.clip(radius / pixel / SHADOW_CELLS_PER_RADIUS, 1, params.shadow_cell))
     return geo, Target(index=index, planes=plane_ids, centre=centre, radius=radius, fine_cell=fine_cell,
-                       eps=1e-6 * geo.scale, surface_key=surface_keys(geo))
+                       shadow_cell=shadow_cell, eps=1e-6 * geo.scale, surface_key=surface_keys(geo))
 
 
 def object_index(scene: SceneData, object_name: str) -> int:

@@ -213,10 +213,13 @@ def test_a_move_in_a_turned_world_and_across_the_seam_is_the_same_move(tiny, unt
     assert np.array_equal(turned.hidden_mask, hidden)
     expected = np.roll(unturned.difference, columns, axis=1)
     error, size = np.abs(turned.difference - expected) @ LUMA, np.abs(expected) @ LUMA
-    # The light: the same to rounding (measured 0.3-0.5 % in all, at most 3e-4 a pixel).
-    assert error[~hidden].sum() <= 0.01 * size[~hidden].sum() and error[~hidden].max() <= 1e-3
-    # The fill: its brightness (a pixel's choice of source flips with the rounding).
-    assert (turned.difference @ LUMA)[hidden].mean() == pytest.approx((expected @ LUMA)[hidden].mean(), rel=0.1)
+    # The light: the same to rounding, at most 1e-3 a pixel. In all 2.5 % (0.3-0.5 % with one
+    # fine lattice near the object): the insertion's passes read back light from the coarser
+    # lattice beyond 1.6 object radii, whose vertices the turned room's rounding moves a hair.
+    assert error[~hidden].sum() <= 0.03 * size[~hidden].sum() and error[~hidden].max() <= 1e-3
+    # The fill: its brightness (a pixel's choice of source flips with the rounding: 4-12 % apart
+    # as the fine lattice's reach is varied from 1.6 to 2.5 object radii).
+    assert (turned.difference @ LUMA)[hidden].mean() == pytest.approx((expected @ LUMA)[hidden].mean(), rel=0.15)
 
 
 def test_above_the_working_resolution_the_move_is_solved_on_the_working_copy_and_the_removal_at_full_size(tiny):
