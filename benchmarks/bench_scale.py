@@ -3,7 +3,7 @@
     .venv/bin/python benchmarks/bench_scale.py [--sizes 1024,2048,4096,8192,16384]
         [--splits 1,9,29,64] [--quality draft,balanced,final] [--engine]
         [--truth-sizes 2048] [--scene basic_box] [--width 1024] [--samples 8]
-        [--working-widths 512,1024,2048]
+        [--working-widths 512,1024,2048] [--rooms hotel_chair,interior]
 
 Each row is one removal in a fresh process, measured from outside: wall seconds from its
 start to its exit and its peak resident memory (that child's rusage). By default the process
@@ -22,8 +22,12 @@ as its world image, or the split mesh) is built once by a bpy subprocess and cac
 .cache/bench_scale. The ratio columns divide by the row of the --width panorama with k = 1 of
 the same preset (and working width) in the same run; --working-widths repeats each preset's
 rows with the light solved at those widths (`--working-width`), default the preset's own.
-The targets are 8K within 4x the 1K time and 3 GB, 16K within 8 GB, 49k triangles within 2x
-the 12-triangle time and memory. Timings on a shared machine are noisy: compare the rows of
+--rooms adds rows of other rooms at --width, divided by the same row: a scene spec rendered
+(hotel_chair: a photo-textured room lit through a window with a sun patch, a chair with legs)
+and `interior`, Blender's hotel-room photograph with its room and armchair built from the
+committed click file. The targets are 8K within 3x the 1K time and 3 GB, 16K within 8 GB,
+200k triangles within 2x the 12-triangle time, and the window-lit room and the photograph
+within 2x the box's. Timings on a shared machine are noisy: compare the rows of
 one run. Under the table, the floor the largest panorama's rows compare against: what reading
 its EXR, one numpy pass over its pixels and writing it once cost in this process. The table is
 printed and written into docs/results/bench_scale.md.
@@ -61,13 +65,16 @@ COLUMNS = ("preset", "path", "panorama", "source", "object triangles", "seconds"
 @dataclass(frozen=True)
 class Case:
     """One row's input: a `width` x width/2 panorama, upsampled `factor` times from the pair
-    `pair` (1: the pair's own render, which scores the edit), the object split into `split`^2."""
+    `pair` (1: the pair's own render, which scores the edit; None: a photograph, unscored), the
+    object `name` split into `split`^2, and what the row says the panorama is."""
 
     width: int
     split: int
     factor: int
-    pair: dict[str, Path]
+    pair: dict[str, Path] | None
     folder: Path
+    name: str
+    source: str
 
 
 #: A preset's name and the working width it solves at (None: the preset's own).
@@ -96,11 +103,29 @@ def _cases(args: argparse.Namespace) -> list[Case]:
         spec = scene_specs.get(args.scene).with_render(width=source, height=source // 2, samples=args.samples)
         factor = width // source
         folder = CACHE / spec.key() / f"x{factor}-k{split}"
-        case = Case(width, split, factor, render_pair(spec), folder)
+        source_label = "render" if factor == 1 else f"upsampled x{factor}"
+        case = Case(width, split, factor, render_pair(spec), folder, spec.remove, source_label)
         if not _built(folder):
-            _setup(case, spec.remove)
+            _setup(case)
         cases.append(case)
-    return cases
+    return cases + [_room(room, args) for room in args.rooms.split(",") if room]
+
+
+def _room(room: str, args: argparse.Namespace) -> Case:
+    """A row of another room at --width: a scene spec rendered with Cycles (a window-lit one), or
+    `interior`, Blender's hotel-room photograph (1024x512) with its room and armchair built from
+    the committed click file (`real_photo_crops`)."""
+    if room == "interior":
+        if args.width != 1024:
+            sys.exit("the interior photograph is 1024x512: run the interior row at --width 1024")
+        case = Case(args.width, 1, 1, None, CACHE / "interior", "Armchair", "interior.exr photograph")
+    else:
+        spec = scene_specs.get(room).with_render(width=args.width, height=args.width // 2, samples=args.samples)
+        case = Case(args.width, 1, 1, render_pair(spec), CACHE / spec.key() / "x1-k1", spec.remove,
+                    f"{room} render")
+    if not _built(case.folder):
+        _setup(case)
+    return case
 
 
 def _built(folder: Path) -> bool:
@@ -112,11 +137,12 @@ def _built(folder: Path) -> bool:
     return hdri is not None and (folder / hdri).is_file()
 
 
-def _setup(case: Case, name: str) -> None:
+def _setup(case: Case) -> None:
     print(f"building the {case.width}x{case.width // 2}, k={case.split} input in {case.folder}", file=sys.stderr)
     case.folder.mkdir(parents=True, exist_ok=True)
-    command = [sys.executable, __file__, "--setup", str(case.folder), "--blend", str(case.pair["blend"]),
-               "--object", name, "--factor", str(case.factor), "--split", str(case.split)]
+    scene = ["--photo", "hotel"] if case.pair is None else ["--blend", str(case.pair["blend"])]
+    command = [sys.executable, __file__, "--setup", str(case.folder), *scene,
+               "--object", case.name, "--factor", str(case.factor), "--split", str(case.split)]
     proc = subprocess.run(command, cwd=REPO, capture_output=True, text=True)
     if proc.returncode:
         sys.exit(f"building {case.folder} failed:\n{(proc.stdout + proc.stderr)[-3000:]}")
@@ -131,6 +157,10 @@ def _build(args: argparse.Namespace) -> None:
     from addon.blender.blend_file import open_blend
     from scenes.images import write_exr
 
+    if args.photo is not None:
+        from real_photo_crops import _scenes, build
+
+        args.blend, _ = build(_scenes()[args.photo], args.setup / "photo")
     open_blend(str(args.blend))
     scene = bpy.context.scene
     if args.factor > 1:
@@ -211,15 +241,15 @@ def _measure(command: list[str], out: Path) -> Measured:
     return Measured(proc.returncode, time.perf_counter() - started, usage.ru_maxrss / 2**20, out / "result")
 
 
-def _run(case: Case, name: str, preset: Preset, engine: bool, folder: Path) -> Measured:
+def _run(case: Case, preset: Preset, engine: bool, folder: Path) -> Measured:
     quality, working_width = preset
-    out = folder / f"{quality}-{working_width}-{case.width}-k{case.split}"
+    out = folder / f"{quality}-{working_width}-{case.width}-k{case.split}-{case.folder.name}-{case.name}"
     if engine:
-        command = [sys.executable, __file__, "--engine-child", str(case.folder), "--object", name,
+        command = [sys.executable, __file__, "--engine-child", str(case.folder), "--object", case.name,
                    "--quality", quality, "--out", str(out / "result")]
-        command += ["--difference"] if case.factor == 1 else []
+        command += ["--difference"] if case.pair is not None and case.factor == 1 else []
     else:
-        command = [sys.executable, "-m", "addon.cli", "remove", str(case.folder / "scene.blend"), "--object", name,
+        command = [sys.executable, "-m", "addon.cli", "remove", str(case.folder / "scene.blend"), "--object", case.name,
                    "--out", str(out / "result"), "--quality", quality]
     command += [] if working_width is None else ["--working-width", str(working_width)]
     return _measure(command, out)
@@ -227,7 +257,7 @@ def _run(case: Case, name: str, preset: Preset, engine: bool, folder: Path) -> M
 
 def _error(case: Case, run: Measured, engine: bool) -> str:
     """The lighting error ratio against the truth of a rendered size, else ''."""
-    if case.factor != 1:
+    if case.pair is None or case.factor != 1:
         return ""
     inp, truth, mask = read_exr(case.pair["input"]), read_exr(case.pair["truth"]), np.load(case.pair["mask"])
     edited = inp + np.load(run.out / "difference.npy") if engine else read_exr(run.out / "edited.exr")
@@ -237,9 +267,8 @@ def _error(case: Case, run: Measured, engine: bool) -> str:
 def _cells(preset: Preset, engine: bool, case: Case, run: Measured, base: Measured) -> list[str]:
     quality, working_width = preset
     panorama = f"{case.width}x{case.width // 2}"
-    source = "render" if case.factor == 1 else f"upsampled x{case.factor}"
     label = quality if working_width is None else f"{quality}, solved at {working_width}"
-    head = [label, "engine" if engine else "cli", panorama, source]
+    head = [label, "engine" if engine else "cli", panorama, case.source]
     triangles = json.loads((case.folder / "case.json").read_text())["triangles"]
     if run.status:
         tail = (run.out.parent / "log.txt").read_text().strip().splitlines() or ["no output"]
@@ -314,8 +343,12 @@ def main() -> None:
     ap.add_argument("--truth-sizes", default="2048", help="widths also rendered with Cycles, so scored")
     ap.add_argument("--working-widths", default="", help="working widths, comma-separated (default: the preset's)")
     ap.add_argument("--engine", action="store_true", help="the engine alone instead of the command line")
+    ap.add_argument("--rooms", default="hotel_chair,interior",
+                    help="rows of other rooms at --width: scene specs (hotel_chair: lit through a window with a "
+                         "sun patch) and interior (Blender's hotel photograph); '' for none")
     ap.add_argument("--setup", type=Path, help=argparse.SUPPRESS)
     ap.add_argument("--blend", type=Path, help=argparse.SUPPRESS)
+    ap.add_argument("--photo", help=argparse.SUPPRESS)
     ap.add_argument("--working-width", type=int, help=argparse.SUPPRESS)
     ap.add_argument("--factor", type=int, default=1, help=argparse.SUPPRESS)
     ap.add_argument("--split", type=int, default=1, help=argparse.SUPPRESS)
@@ -332,18 +365,17 @@ def main() -> None:
         return
     if any(w % args.width for w in _ints(args.sizes)):
         ap.error("--sizes must be multiples of --width")
-    name = scene_specs.get(args.scene).remove
     cases = _cases(args)
     pair = cases[0].pair
     floor = metrics.noise_floor(read_exr(pair["input"]), read_exr(pair["truth"]), np.load(pair["mask"]))
     rows, profiles = [], []
-    widest = max(cases, key=lambda c: (c.width, -c.split))
+    widest = max(cases, key=lambda c: (c.width, -c.split, c.pair is not None))
     with tempfile.TemporaryDirectory() as folder:
         widths = _ints(args.working_widths) or [None]
         for preset in [(quality, w) for quality in args.quality.split(",") for w in widths]:
-            base = _run(cases[0], name, preset, args.engine, Path(folder))
+            base = _run(cases[0], preset, args.engine, Path(folder))
             for case in cases:
-                run = base if case is cases[0] else _run(case, name, preset, args.engine, Path(folder))
+                run = base if case is cases[0] else _run(case, preset, args.engine, Path(folder))
                 rows.append(_cells(preset, args.engine, case, run, base))
                 print(" | ".join(rows[-1]), file=sys.stderr, flush=True)
                 if case is widest:
