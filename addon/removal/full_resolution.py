@@ -27,7 +27,7 @@ from .fill import Revealed, fill_hidden, hidden_light, hidden_planes, measured_r
 from .local import Receiving, light_at
 from .object_window import ObjectWindow, object_window
 from .relit_noise import relit_noise_stage
-from .seam import seamless_change
+from .seam import seamless_block_change
 from .solution import Solution
 from .working_maps import Cells, WorkingMaps, cells, neighbours, surfaces_seen, working_maps
 
@@ -114,7 +114,8 @@ def full_resolution(solution: Solution, hdri: np.ndarray, rep: Report, callbacks
         with rep.stage("synthesis"):
             change = fill_hidden(solution, found, light, rep, callbacks)
             difference[rows[revealed], cols[revealed]] = change
-            difference[rows, cols] = seamless_change(radiance, difference[rows, cols], revealed, surfaces.without)
+            difference[rows, cols] = seamless_block_change(radiance, difference[rows, cols], revealed,
+                                                           surfaces.without)
     else:
         rep.skip("synthesis", "nothing is behind the object to fill")
     unseen = int(window.hidden.sum() - revealed.sum())

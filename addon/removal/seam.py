@@ -119,6 +119,22 @@ def _pull_push(values: np.ndarray, known: np.ndarray) -> np.ndarray:
     return np.where(known[..., None], values, smooth)
 
 
+def seamless_block_change(radiance: np.ndarray, change: np.ndarray, filled: np.ndarray, surface: np.ndarray
+                          ) -> np.ndarray:
+    """`seamless_change` over an image that does not wrap around (a window of the panorama), on
+    the block around the filled pixels that the step and the surface's own steps are measured
+    in: at full resolution the object's window is several times larger than that."""
+    out = np.array(change, dtype=np.float32, copy=True)
+    if not filled.any():
+        return out
+    margin = _WINDOW_REACHES * _MAX_REACH
+    rows, cols = np.flatnonzero(filled.any(axis=1)), np.flatnonzero(filled.any(axis=0))
+    block = (slice(max(rows[0] - margin, 0), rows[-1] + margin + 1),
+             slice(max(cols[0] - margin, 0), cols[-1] + margin + 1))
+    out[block] = seamless_change(radiance[block], out[block], filled[block], surface[block])
+    return out
+
+
 def seamless_panorama_change(radiance: np.ndarray, change: np.ndarray, filled: np.ndarray, surface: np.ndarray
                              ) -> np.ndarray:
     """`seamless_change` over a whole lat-long panorama, on the window around the filled pixels
