@@ -132,13 +132,15 @@ def _smooth_cells(points: np.ndarray, normals: np.ndarray, usable: np.ndarray, g
     smooth = ok & (np.bincount(pair_cell, spread, minlength=len(cells)) <= allowed)
     # Corners that differ more may still hold a gradient, which the mix follows: the cell's
     # middle pixel tells it from a shadow's edge or a bend, where the mix misses the middle.
-    middle = row_of[(r0 + cell // 2) * grid.width + (c0 + cell // 2) % grid.width]
+    middle = row_of[np.minimum(r0 + cell // 2, grid.height - 1) * grid.width + (c0 + cell // 2) % grid.width]
     ask = ok & ~smooth & (middle >= 0)
     ask[ask] = usable[middle[ask]] & _on_plane(points, normals, middle[ask], corner[ask])
     asked = ask[pair_cell]
     m_e, m_de = shadow(middle[pair_cell[asked]], present[pair_column[asked]])
-    missed_e = _sum_rows(pair_cell[asked], u_e[inverse[asked]].mean(axis=1) - m_e, len(cells)) @ LUMA
-    missed_de = _sum_rows(pair_cell[asked], u_de[inverse[asked]].mean(axis=1) - m_de, len(cells)) @ LUMA
+    f = (cell // 2) / cell  # the middle pixel's place in the cell, along each axis
+    mix = np.array([(1 - f) * (1 - f), (1 - f) * f, f * (1 - f), f * f])
+    missed_e = _sum_rows(pair_cell[asked], mix @ u_e[inverse[asked]] - m_e, len(cells)) @ LUMA
+    missed_de = _sum_rows(pair_cell[asked], mix @ u_de[inverse[asked]] - m_de, len(cells)) @ LUMA
     smooth |= ask & (np.maximum(np.abs(missed_e), np.abs(missed_de)) <= allowed)
     corner_e, corner_de = np.zeros((len(cells), 4, 3)), np.zeros((len(cells), 4, 3))
     for k in range(4):

@@ -103,6 +103,15 @@ def test_a_pixel_is_never_interpolated_from_corners_on_another_surface():
     assert cells.interpolated_points <= H * (W - 4) - H * 4
 
 
+def test_cells_that_do_not_divide_the_panorama_leave_its_last_rows_computed():
+    points, normals, grid = _floor()
+    steep = lambda x, y: 5.0 * x + 3.0 * y  # noqa: E731
+    exact, _ = _run(points, normals, grid, steep, cell=1)
+    cells, _ = _run(points, normals, grid, steep, cell=3, budget=1e-6)
+    assert cells.interpolated_points > 0
+    np.testing.assert_allclose(cells.e, exact.e, atol=1e-9)
+
+
 def test_without_a_grid_every_pair_is_computed():
     points, normals, _ = _floor()
     linear = lambda x, y: x  # noqa: E731
