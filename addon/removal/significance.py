@@ -1,9 +1,11 @@
-"""Where the object may cast a shadow of an important sender worth computing exactly."""
+"""Where the object may cast a shadow of an important sender worth computing exactly: the
+conservative bounding-sphere test of its shadow volume (the segment from a receiver towards the
+sender's centre passes within the object's radius plus the sender's of the object's centre),
+where the sender's unblocked light is worth it."""
 from __future__ import annotations
 
 import numpy as np
 
-from ..light.planner import in_shadow_volume
 from ..light.radiosity import LUMA
 from ..light.transport import Senders
 from ..quality import Params
@@ -27,13 +29,22 @@ def significant(senders: Senders, imp: np.ndarray, points: np.ndarray, e_points:
     b_y = senders.radiosity[imp] @ LUMA
     tris = senders.triangles[imp]
     area = np.linalg.norm(np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0]), axis=1) / 2
-    # Sender by sender: (N, I) temporaries of a window-lit room's half a million pixels would
-    # cost more in memory traffic than the arithmetic.
+    # Sender by sender over (N,) vectors, relative to the object's centre: with |q|^2 of every
+    # point known, the distance to a sender and the shadow volume's test (the segment towards
+    # the sender's centre passes within the two radii of the object's centre) cost a
+    # matrix-vector product and a few vector operations a sender, not (N, 3) arrays of them.
     least = np.pi * params.significance * np.maximum(e_points @ LUMA, 1e-30)
-    obj_radius = np.broadcast_to(target.radius + np.asarray(margin, dtype=np.float64), (len(points),))
+    reach2 = (target.radius + np.asarray(margin, dtype=np.float64) + imp_r[:, None]) ** 2  # (I, N or 1)
+    q = points - target.centre
+    qq = np.einsum("ij,ij->i", q, q)
+    ends = imp_c - target.centre
     out = np.zeros((len(points), len(imp)), dtype=bool)
     for s in range(len(imp)):
-        gap = points - imp_c[s]
-        rows = np.flatnonzero(b_y[s] * area[s] >= least * (np.einsum("ij,ij->i", gap, gap) + imp_r[s] ** 2))
-        out[rows, s] = in_shadow_volume(points[rows], imp_c[s], imp_r[s], target.centre, obj_radius[rows])
+        qc = q @ ends[s]
+        dd = np.maximum(ends[s] @ ends[s] - 2.0 * qc + qq, 0.0)  # |p - c|^2
+        rows = np.flatnonzero(b_y[s] * area[s] >= least * (dd + imp_r[s] ** 2))
+        toward = qq[rows] - qc[rows]  # (o - p) . (c - p)
+        t = np.clip(toward / np.maximum(dd[rows], 1e-300), 0.0, 1.0)
+        gap2 = qq[rows] - 2.0 * t * toward + t * t * dd[rows]
+        out[rows, s] = gap2 <= np.broadcast_to(reach2[s], (len(points),))[rows]
     return out
