@@ -161,4 +161,5 @@ def light_at(lit: LitRoom, receiving: Receiving, params: Params, callbacks: RunC
                            candidate[pair_row], imp[pair_sender], params.significance * np.maximum(e_h @ LUMA, 0.0),
                            shadow, cell=target.shadow_cell)
     return PointLight(e_h + shadows.e, de_h + shadows.de, affected, fine_vertices, len(pair_row),
-                      shadows.interpolated_points, shadows.exact_pairs, tuple(groups.sizes[groups.sizes > 1].tolist()))
+                      shadows.interpolated_points, shadows.computed_pairs,
+                      tuple(groups.sizes[groups.sizes > 1].tolist()))

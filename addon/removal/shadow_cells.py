@@ -51,7 +51,7 @@ class CellShadows:
     e: np.ndarray
     de: np.ndarray
     interpolated_points: int
-    exact_pairs: int
+    computed_pairs: int
 
 
 def cell_shadows(points: np.ndarray, normals: np.ndarray, usable: np.ndarray, grid: PixelGrid | None,
@@ -64,11 +64,11 @@ def cell_shadows(points: np.ndarray, normals: np.ndarray, usable: np.ndarray, gr
     n = len(points)
     e, de = np.zeros((n, 3)), np.zeros((n, 3))
     interpolated = np.zeros(n, dtype=bool)
-    exact_pairs = 0
+    computed = 0
     if grid is not None and cell > 1 and len(rows):
         served, corner_e, corner_de, corner_pairs = _smooth_cells(points, normals, usable, grid, rows, senders,
                                                                   budget, shadow, cell)
-        exact_pairs += corner_pairs
+        computed += corner_pairs
         e[served.rows] = np.einsum("nk,nkc->nc", served.weights, corner_e[served.cell])
         de[served.rows] = np.einsum("nk,nkc->nc", served.weights, corner_de[served.cell])
         interpolated[served.rows] = True
@@ -78,7 +78,7 @@ def cell_shadows(points: np.ndarray, normals: np.ndarray, usable: np.ndarray, gr
     add_e, add_de = shadow(rows[own], senders[own])
     e += _sum_rows(rows[own], add_e, n)
     de += _sum_rows(rows[own], add_de, n)
-    return CellShadows(e, de, int(interpolated.sum()), exact_pairs + int(own.sum()))
+    return CellShadows(e, de, int(interpolated.sum()), computed + int(own.sum()))
 
 
 @dataclass(frozen=True)
@@ -137,8 +137,8 @@ def _smooth_cells(points: np.ndarray, normals: np.ndarray, usable: np.ndarray, g
     ask[ask] = usable[middle[ask]] & _on_plane(points, normals, middle[ask], corner[ask])
     asked = ask[pair_cell]
     m_e, m_de = shadow(middle[pair_cell[asked]], present[pair_column[asked]])
-    f = (cell // 2) / cell  # the middle pixel's place in the cell, along each axis
-    mix = np.array([(1 - f) * (1 - f), (1 - f) * f, f * (1 - f), f * f])
+    half = np.array((cell // 2) / cell)  # the middle pixel's place in the cell, along each axis
+    mix = _bilinear(half, half)
     missed_e = _sum_rows(pair_cell[asked], mix @ u_e[inverse[asked]] - m_e, len(cells)) @ LUMA
     missed_de = _sum_rows(pair_cell[asked], mix @ u_de[inverse[asked]] - m_de, len(cells)) @ LUMA
     smooth |= ask & (np.maximum(np.abs(missed_e), np.abs(missed_de)) <= allowed)
@@ -153,10 +153,14 @@ def _smooth_cells(points: np.ndarray, normals: np.ndarray, usable: np.ndarray, g
     p, p_cell = p[smooth[p_cell]], p_cell[smooth[p_cell]]
     flat = _on_plane(points, normals, p, corner[p_cell])
     p, p_cell = p[flat], p_cell[flat]
-    fr = (r[p] - r0[p_cell]) / cell
-    fc = ((c[p] - c0[p_cell]) % grid.width) / cell
-    weights = np.stack([(1 - fr) * (1 - fc), (1 - fr) * fc, fr * (1 - fc), fr * fc], axis=1)
+    weights = _bilinear((r[p] - r0[p_cell]) / cell, ((c[p] - c0[p_cell]) % grid.width) / cell)
     return _Served(p, p_cell, weights), corner_e, corner_de, len(unique) + int(asked.sum())
+
+
+def _bilinear(fr: np.ndarray, fc: np.ndarray) -> np.ndarray:
+    """(..., 4) the weights of a cell's corners (top left, top right, bottom left, bottom right)
+    at the place (fr, fc) in it, each a share of the cell's side."""
+    return np.stack([(1 - fr) * (1 - fc), (1 - fr) * fc, fr * (1 - fc), fr * fc], axis=-1)
 
 
 def _on_plane(points: np.ndarray, normals: np.ndarray, p: np.ndarray, corners: np.ndarray) -> np.ndarray:

@@ -119,7 +119,7 @@ def test_without_a_grid_every_pair_is_computed():
     shadow, asked = _shadow(points, linear)
     result = cell_shadows(points, normals, np.ones(len(points), dtype=bool), None, rows, senders,
                           np.ones(len(points)), shadow, cell=4)
-    assert result.interpolated_points == 0 and sum(asked) == len(rows) == result.exact_pairs
+    assert result.interpolated_points == 0 and sum(asked) == len(rows) == result.computed_pairs
 
 
 def test_unusable_corners_leave_their_cells_computed():
