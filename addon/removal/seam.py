@@ -30,9 +30,9 @@ _SIGNIFICANCE = 1.0
 # quantile of them, not their median, is what a boundary may show by chance.
 _STEP_QUANTILE = 0.9
 _ALIKE = 4.0  # within this factor of the boundary's median luminance: the surface's material
-# The window seamless_panorama_change works in reaches past the filled pixels: the bands, the
+# The block seamless_block_change works in reaches past the filled pixels: the bands, the
 # steps' averaging along the boundary and the surface's own steps around it all lie within.
-_WINDOW_REACHES = 4
+_BLOCK_REACHES = 4
 _AROUND = 2  # reaches: the surface around the hole whose own steps are measured
 
 
@@ -127,7 +127,7 @@ def seamless_block_change(radiance: np.ndarray, change: np.ndarray, filled: np.n
     out = np.array(change, dtype=np.float32, copy=True)
     if not filled.any():
         return out
-    margin = _WINDOW_REACHES * _MAX_REACH
+    margin = _BLOCK_REACHES * _MAX_REACH
     rows, cols = np.flatnonzero(filled.any(axis=1)), np.flatnonzero(filled.any(axis=0))
     block = (slice(max(rows[0] - margin, 0), rows[-1] + margin + 1),
              slice(max(cols[0] - margin, 0), cols[-1] + margin + 1))
@@ -137,23 +137,16 @@ def seamless_block_change(radiance: np.ndarray, change: np.ndarray, filled: np.n
 
 def seamless_panorama_change(radiance: np.ndarray, change: np.ndarray, filled: np.ndarray, surface: np.ndarray
                              ) -> np.ndarray:
-    """`seamless_change` over a whole lat-long panorama, on the window around the filled pixels
-    that the step and the surface's own steps are measured in: turned by whole columns so that
-    it lies away from the u seam, where the image's columns wrap around."""
+    """`seamless_block_change` over a whole lat-long panorama, turned by whole columns so that
+    the block lies away from the u seam, where the image's columns wrap around."""
     out = np.array(change, dtype=np.float32, copy=True)
     if not filled.any():
         return out
-    height, width = filled.shape
+    width = filled.shape[1]
     columns = np.flatnonzero(filled.any(axis=0))
     # the middle of the filled columns' widest gap is where the seam goes
     gaps = np.diff(np.concatenate([columns, [columns[0] + width]]))
     widest = int(np.argmax(gaps))
-    start = int(columns[widest]) + int(gaps[widest]) // 2 - width  # the window's columns from here
-    first, last = (int(np.mod(c - start, width)) for c in (columns[(widest + 1) % len(columns)], columns[widest]))
-    margin = _WINDOW_REACHES * _MAX_REACH
-    cols = np.mod(start + np.arange(max(first - margin, 0), min(last + margin + 1, width)), width)
-    rows_filled = np.flatnonzero(filled.any(axis=1))
-    rows = np.arange(max(rows_filled[0] - margin, 0), min(rows_filled[-1] + margin + 1, height))
-    window = np.ix_(rows, cols)
-    out[window] = seamless_change(radiance[window], out[window], filled[window], surface[window])
+    turned = np.mod(int(columns[widest]) + int(gaps[widest]) // 2 + np.arange(width), width)
+    out[:, turned] = seamless_block_change(radiance[:, turned], out[:, turned], filled[:, turned], surface[:, turned])
     return out
