@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING
 from .. import memory
 from ..callbacks import RunCallbacks
 from ..errors import DimredError
+from ..page_advice import without_huge_page_advice
 from ..quality import DEFAULT_QUALITY, DESCRIPTIONS, MIN_WORKING_WIDTH, PRESETS, working_width_problem
 from . import batch_cli, room_cli
 
@@ -124,7 +125,9 @@ def run_cli(argv: Sequence[str], *, blend_already_loaded: bool) -> int:
         # argparse exits after --help or a usage error; both callers want a status returned.
         return stop.code if isinstance(stop.code, int) else EXIT_BAD_INPUT
     try:
-        return args.run(args)
+        # Reading and writing the panorama allocate as much as the removal does.
+        with without_huge_page_advice():
+            return args.run(args)
     except DimredError as error:
         # The contract is one line, whatever the message holds.
         print(f"{PROG}: error: {' '.join(str(error).split())}", file=sys.stderr, flush=True)

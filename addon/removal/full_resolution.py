@@ -24,9 +24,10 @@ from ..report import Report
 from ..synthesis.plane_fill import PanoramaMaps, PanoramaReflectance
 from .compose import ratio_change, reference_irradiance
 from .fill import Revealed, fill_hidden, hidden_light, hidden_planes, measured_reflectance, surface_footprint
-from .local import Receiving, light_at
+from .local import PointLight, Receiving, light_at
 from .object_window import ObjectWindow, object_window
 from .relit_noise import relit_noise_stage
+from .ring_samples import MIN_FACTOR, ring_samples
 from .seam import seamless_block_change
 from .solution import Solution
 from .working_maps import Cells, WorkingMaps, cells, neighbours, surfaces_seen, working_maps
@@ -321,19 +322,49 @@ def _refine(solution: Solution, refine: _Refine, canvas: _Canvas, rep: Report, c
     keep[optional[np.argsort(-refine.spread[optional], kind="stable")[:budget]]] = True
     rep.info["refined_pixels"] = {"needed": int(needed.sum()), "sharp_edges": int(min(len(optional), budget)),
                                   "sharp_edges_left": int(max(0, len(optional) - budget))}
-    for beside in (True, False):
-        chosen = keep & (refine.beside == beside)
-        if chosen.any():
-            _refined_light(solution, refine.take(chosen), canvas, rep, callbacks, per_point=beside)
+    if (keep & refine.beside).any():
+        _ring_light(solution, refine.take(keep & refine.beside), canvas, rep, callbacks)
+    others = refine.take(keep & ~refine.beside)
+    if len(others.pixel):
+        light = _own_light(solution, others, canvas, rep, callbacks, per_point=False)
+        _write_light(solution, others, light.e, light.de, canvas, rep)
 
 
-def _refined_light(solution: Solution, refine: _Refine, canvas: _Canvas, rep: Report, callbacks: RunCallbacks, *,
-                   per_point: bool) -> None:
-    """Write the change of full-resolution pixels (`refine`: flat pixel, the triangle it sees at
-    its barycentric weights and distance) from their own light."""
-    pixel, tri, bary, hdri = refine.pixel, refine.tri, refine.bary, canvas.hdri
-    height, width = hdri.shape[:2]
-    rows, cols = np.divmod(pixel, width)
+def _ring_light(solution: Solution, ring: _Refine, canvas: _Canvas, rep: Report, callbacks: RunCallbacks) -> None:
+    """The light of the pixels beside the object, each at its own point; on a panorama
+    MIN_FACTOR or more times finer than the working copy from samples on every other pixel."""
+    height, width = canvas.hdri.shape[:2]
+    window = canvas.window
+    if window is None or width < MIN_FACTOR * solution.traced.width:
+        light = _own_light(solution, ring, canvas, rep, callbacks, per_point=True)
+        _write_light(solution, ring, light.e, light.de, canvas, rep)
+        return
+    keys = solution.target.surface_key
+
+    def surface_at(rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+        wr, wc, inside = window.holds(rows, cols)
+        usable = inside & ~window.hidden[wr, wc] & ~window.kept[wr, wc]
+        return surfaces_of(keys, np.where(usable, window.tri[wr, wc], -1))
+
+    samples = ring_samples(ring.pixel, width, height, surface_at)
+    wr, wc, _ = window.holds(*np.divmod(samples.computed, width))
+    n = len(samples.computed)
+    at = _Refine(samples.computed, window.tri[wr, wc].astype(np.int64), window.bary[wr, wc].astype(np.float64),
+                 window.distance[wr, wc].astype(np.float64), np.full(n, np.inf), np.ones(n, dtype=bool))
+    light = _own_light(solution, at, canvas, rep, callbacks, per_point=True)
+    rep.info["ring_samples"] = {"pixels": len(ring.pixel), "computed": n}
+    e = np.einsum("nk,nkc->nc", samples.weight, light.e[samples.corner])
+    de = np.einsum("nk,nkc->nc", samples.weight, light.de[samples.corner])
+    _write_light(solution, ring, e, de, canvas, rep)
+
+
+def _own_light(solution: Solution, refine: _Refine, canvas: _Canvas, rep: Report, callbacks: RunCallbacks, *,
+               per_point: bool) -> PointLight:
+    """The light of full-resolution pixels (`refine`: flat pixel, the triangle it sees at its
+    barycentric weights and distance) from their own transport."""
+    tri, bary = refine.tri, refine.bary
+    height, width = canvas.hdri.shape[:2]
+    rows, cols = np.divmod(refine.pixel, width)
     room, geo, target = solution.room, solution.geo, solution.target
     points = latlong.pixel_directions_at(rows, cols, width, height) * refine.distance[:, None]
     patch, corners, weights = room.patches.lattice.locate(tri, bary)
@@ -345,12 +376,20 @@ def _refined_light(solution: Solution, refine: _Refine, canvas: _Canvas, rep: Re
     light = light_at(solution.lit, receiving, solution.params, callbacks, per_point=per_point)
     key = "refined_exact_pairs"
     rep.info[key] = rep.info.get(key, 0) + light.exact_pairs
+    return light
+
+
+def _write_light(solution: Solution, refine: _Refine, e: np.ndarray, de: np.ndarray, canvas: _Canvas,
+                 rep: Report) -> None:
+    """Write the change of the pixels `refine` from their light E and dE (N, 3)."""
+    pixel, hdri, room = refine.pixel, canvas.hdri, solution.room
+    patch, _, _ = room.patches.lattice.locate(refine.tri, refine.bary)
     radiance = np.maximum(hdri.reshape(-1, 3)[pixel].astype(np.float64), 0.0)
-    canvas.difference.reshape(-1, 3)[pixel] = ratio_change(radiance, light.e, light.de, ~room.emitter[patch],
+    canvas.difference.reshape(-1, 3)[pixel] = ratio_change(radiance, e, de, ~room.emitter[patch],
                                                            e_ref=canvas.e_ref, rep=rep)
     if canvas.window is not None and canvas.window_e is not None:
-        wr, wc, inside = canvas.window.holds(rows, cols)
-        canvas.window_e[wr[inside], wc[inside]] = light.e[inside]
+        wr, wc, inside = canvas.window.holds(*np.divmod(pixel, hdri.shape[1]))
+        canvas.window_e[wr[inside], wc[inside]] = e[inside]
 
 
 @dataclass(frozen=True)

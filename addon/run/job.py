@@ -34,6 +34,7 @@ from ..composition import on_earlier
 from ..errors import DimredError
 from ..geometry.mesh import to_probe_frame
 from ..io.exr import read_exr, write_exr
+from ..page_advice import without_huge_page_advice
 from ..pipeline import relocate_object, remove_object
 from ..quality import DEFAULT_QUALITY
 from ..relocation.fixedview import Move
@@ -111,6 +112,12 @@ def loaded(scene: SceneData) -> SceneData:
 def run(request: RemovalRequest, callbacks: RunCallbacks = NO_CALLBACKS) -> RemovalOutcome:
     """Remove (or relocate) the requested object; `callbacks.preview` gets `preview.Preview`s:
     a quick fill first, then the engine's."""
+    # Reading the panorama and writing the layer allocate as much as the removal does.
+    with without_huge_page_advice():
+        return _run(request, callbacks)
+
+
+def _run(request: RemovalRequest, callbacks: RunCallbacks) -> RemovalOutcome:
     wanted = callbacks.preview is not None
     _progress(callbacks, "preview")
     panorama, base = _cached(request) if wanted else (None, [None] * len(request.base))
