@@ -347,3 +347,16 @@ def test_png_rejects_other_types(tmp_path):
         exr.write_png(tmp_path / "m.png", np.zeros((4, 4), bool))
     with pytest.raises(ValueError):
         exr.write_png(tmp_path / "m.png", np.zeros((4, 4, 4), np.uint8))
+
+
+def test_a_band_holds_a_chunk_for_each_of_the_librarys_threads(monkeypatch):
+    monkeypatch.setattr(exr, "_codec_threads", lambda: 3)
+    assert list(exr._bands(200, 1 << 18, chunk=32)) == [(0, 96), (96, 192), (192, 200)]
+    monkeypatch.setattr(exr, "_codec_threads", lambda: 1)
+    assert list(exr._bands(100, 1 << 18, chunk=32)) == [(0, 32), (32, 64), (64, 96), (96, 100)]
+
+
+def test_the_librarys_threads_are_started_once_and_left_as_set(monkeypatch):
+    monkeypatch.setattr(exr.OpenEXR, "global_thread_count", lambda: 5)
+    monkeypatch.setattr(exr.OpenEXR, "set_global_thread_count", lambda n: pytest.fail("reset the library's threads"))
+    assert exr._codec_threads() == 5
