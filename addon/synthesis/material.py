@@ -22,10 +22,11 @@ from ..light.radiosity import LUMA
 from ..segmentation.masks import box_mean, box_sum, dilate, erode
 from .shift_map import hole_extent
 
-# Feature bins: log luminance in steps of 0.15, chromaticity (r, g) in steps of 0.03: about what
+# Feature bins: log luminance in steps of 0.3, chromaticity (r, g) in steps of 0.04: about what
 # the eye calls another colour at a glance. A colour is near the bins within one step of its own.
 _STEPS = np.array([0.15, 0.03, 0.03])
 _SECTORS = 8  # directions around the hole
+_CONTACT = 0.05  # of the ring's reach: the band right at the hole left out (its contact shadow)
 _MIN_SECTOR_CELLS = 16  # cells a direction needs around the hole to count
 # Fewer directions or cells around the hole than these tell no material apart from a chance
 # patch of light (a 64x32 panorama's floor): the whole surface is the exemplar then.
@@ -67,9 +68,8 @@ def border_material(image: np.ndarray, known: np.ndarray, hole: np.ndarray, *, m
         return undecided
     reach = int(np.clip(round(hole_extent(hole) / 2), 4, 32))
     near = dilate(hole, reach) & ~hole
-    # The ring's inner half holds the contact shadow and the legs: only its outer half decides.
-    around = known & near & ~dilate(hole, reach // 2)
-    if not around.any():
+    inner = dilate(hole, reach // 2)
+    if not (known & near).any():
         return undecided
     log_y = np.log(np.maximum(image @ LUMA, 1e-4))
     mean, _ = box_mean(np.concatenate([log_y[..., None],
@@ -79,25 +79,32 @@ def border_material(image: np.ndarray, known: np.ndarray, hole: np.ndarray, *, m
     lo = bins[known].min(axis=0)
     shape = tuple(bins[known].max(axis=0) - lo + 1)
     flat = np.ravel_multi_index(tuple(np.moveaxis(np.clip(bins - lo, 0, np.array(shape) - 1), -1, 0)), shape)
-    rows, cols = np.nonzero(around)
-    hr, hc = (float(x.mean()) for x in np.nonzero(hole))
-    sector = ((np.arctan2(rows - hr, cols - hc) + np.pi) / (2 * np.pi) * _SECTORS).astype(np.int64) % _SECTORS
-    counts = np.zeros((int(np.prod(shape)), _SECTORS))
-    np.add.at(counts, (flat[rows, cols], sector), 1.0)
-    per_sector = counts.sum(axis=0)
-    counted = per_sector >= _MIN_SECTOR_CELLS
-    if counted.sum() < _MIN_SECTORS or per_sector.sum() < _MIN_RING_CELLS:
+    centre = tuple(float(x.mean()) for x in np.nonzero(hole))
+    # The band right outside the hole (past its contact shadow) decides first, where one material
+    # surrounds the hole there: farther out, the clutter beside a hole (a rug, a desk chair's foot)
+    # can fill most directions. The ring beyond adds its colours found all round too (the light
+    # printed on a photographed floor shifts its shade from the band to the ring). A hole across
+    # several materials (a painted line between two floors) matches none all round in the band:
+    # the ring beyond decides alone then, with the band (the contact shadow, the legs) left out.
+    rings = ((known & inner & ~dilate(hole, max(1, round(_CONTACT * reach))), _AROUND[:1]),
+             (known & near & ~inner, _AROUND))
+    found, last = [], None
+    for ring, shares in rings:
+        directions = _directions(flat, shape, ring, centre)
+        if directions is None:
+            continue
+        # A floor's light and gloss change its colour from one side of the hole to the other: where
+        # too little of the ring matches colours found all around it, colours found in fewer
+        # directions are taken too, down to half of them (a rug on one side stays out).
+        for share in shares[:1] if found else shares:
+            last = (known & (directions >= share), ring)
+            if (last[0] & ring).sum() >= _RING_MATCH * ring.sum():
+                found.append(last)
+                break
+    if last is None:
         return undecided
-    near_counts = _neighbour_sum(counts.reshape(*shape, _SECTORS))
-    present = near_counts.reshape(-1, _SECTORS) >= np.maximum(_PRESENT * per_sector, 2.0)
-    directions = (present & counted).sum(axis=1)[flat]
-    # A floor's light and gloss change its colour from one side of the hole to the other: where
-    # too little of the ring matches colours found all around it, colours found in fewer
-    # directions are taken too, down to half of them (a rug on one side stays out).
-    for share in _AROUND:
-        matching = known & (directions >= share * counted.sum())
-        if (matching & around).sum() >= _RING_MATCH * around.sum():
-            break
+    matching, around = (np.logical_or.reduce([m for m, _ in found]), np.logical_or.reduce([r for _, r in found])
+                        ) if found else last
     # Cells between a texture's colours (a tile's edge, a seam) may match nothing on their own:
     # only what is wider than a line counts as something else, with a cell of margin around it,
     # unless a cell is darker or brighter than any of the material's (a rug's black stripe).
@@ -118,6 +125,24 @@ def border_material(image: np.ndarray, known: np.ndarray, hole: np.ndarray, *, m
     # Only what is wider than a line is repainted beside the hole: a thin stripe is only left out.
     return Material(exemplar=exemplar, replaced=near & wide, source="border material",
                     share=float(exemplar.sum() / known.sum()))
+
+
+def _directions(flat: np.ndarray, shape: tuple[int, ...], ring: np.ndarray, centre: tuple[float, float]
+                ) -> np.ndarray | None:
+    """(h, w) per cell, the share of the directions around `centre` (those with cells enough of
+    `ring`) in which its colour (bin `flat` (h, w) of a grid of `shape`) is present in `ring`;
+    None where the ring covers too few directions or cells to tell a material apart."""
+    rows, cols = np.nonzero(ring)
+    sector = ((np.arctan2(rows - centre[0], cols - centre[1]) + np.pi) / (2 * np.pi) * _SECTORS).astype(np.int64)
+    counts = np.zeros((int(np.prod(shape)), _SECTORS))
+    np.add.at(counts, (flat[rows, cols], sector % _SECTORS), 1.0)
+    per_sector = counts.sum(axis=0)
+    counted = per_sector >= _MIN_SECTOR_CELLS
+    if counted.sum() < _MIN_SECTORS or per_sector.sum() < _MIN_RING_CELLS:
+        return None
+    present = _neighbour_sum(counts.reshape(*shape, _SECTORS)).reshape(-1, _SECTORS) >= np.maximum(
+        _PRESENT * per_sector, 2.0)
+    return ((present & counted).sum(axis=1) / counted.sum())[flat]
 
 
 def _neighbour_sum(counts: np.ndarray) -> np.ndarray:

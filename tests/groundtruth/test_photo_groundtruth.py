@@ -28,18 +28,17 @@ BOUNDS = {
     "bruise_share": (None, 0.02),
     "far_damage": (None, 0.05),
 }
-# (scene, figure): what the engine measured where it fails the bound (at 27a70e3, 256x128).
+# (scene, figure): what the engine measured where it fails the bound (256x128).
 FAILING: dict[tuple[str, str], str] = {
-    # The fill of the wood between the rug and the desk chair is a quarter darker than the wood
-    # and half as detailed.
-    ("hotel_box", "total"): "measured 0.537",
-    ("hotel_box", "mean_error"): "measured 0.269",
-    ("hotel_box", "detail"): "measured 0.50",
+    # The wood between the rug and the desk chair, lit brighter in the photograph where the box
+    # stands than the wood around it, is filled a fifth too dark.
+    ("hotel_box", "total"): "measured 0.459",
+    ("hotel_box", "mean_error"): "measured 0.182",
     # The rug's stripes and a pale patch of wall drawn into the floor behind the armchair-sized box.
-    ("hotel_walls", "total"): "measured 0.819",
-    ("hotel_walls", "mean_error"): "measured 0.408",
+    ("hotel_walls", "total"): "measured 0.748",
+    ("hotel_walls", "mean_error"): "measured 0.355",
     # The yellow floor line is continued into the hole with a branch the truth does not have.
-    ("workshop_box", "total"): "measured 0.511",
+    ("workshop_box", "total"): "measured 0.358",
 }
 
 

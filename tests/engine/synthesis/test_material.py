@@ -102,3 +102,25 @@ def test_the_same_input_gives_the_same_exemplar() -> None:
     a = border_material(image, ~hole, hole, min_cells=64)
     b = border_material(image, ~hole, hole, min_cells=64)
     assert np.array_equal(a.exemplar, b.exemplar) and a.share == b.share
+
+
+def test_clutter_filling_the_ring_beyond_a_band_of_the_material_is_left_out() -> None:
+    """A hole against the wall, on a band of wood between a rug and a desk chair's dark foot,
+    which fill most directions a few cells farther out: the band right outside the hole decides."""
+    rng = np.random.default_rng(5)
+    image = _wood(rng)
+    hole = _hole()
+    known = ~hole & (np.indices((_H, _W))[1] >= 52)  # the wall left of the hole: no floor seen there
+    rug = np.zeros((_H, _W), bool)
+    rug[10:44, 52:] = True
+    stripes = np.where((np.arange(_W) // 4) % 2, 0.85, 0.04)
+    image[rug] = np.stack([stripes] * 3, axis=-1)[np.nonzero(rug)[1]]
+    foot = np.zeros((_H, _W), bool)
+    foot[44:120, 97:140] = True
+    image[foot] = np.array([0.03, 0.02, 0.015]) * (1 + 0.3 * rng.random((_H, _W, 1)))[foot]
+    got = border_material(image, known, hole, min_cells=64)
+    assert got.source == "border material"
+    wood = known & ~rug & ~foot
+    assert (got.exemplar & wood).sum() > 0.8 * wood.sum()
+    assert (got.exemplar & rug).sum() < 0.02 * rug.sum()
+    assert not (got.exemplar & foot).any()
