@@ -13,7 +13,6 @@ import numpy as np
 from .alignment.fit import Alignment, align_object
 from .callbacks import NO_CALLBACKS, RunCallbacks
 from .errors import DimredError
-from .page_advice import without_huge_page_advice
 from .quality import DEFAULT_QUALITY, Params, params_for
 from .radiance import clamped_rows, negative_pixels, non_finite_pixels
 from .relocation.fixedview import Move
@@ -60,8 +59,7 @@ def _run(scene: SceneData, quality: str, overrides: dict, compute: Callable[[Sce
     if align is not None:
         alignment = align_object(scene, align, params=params, fit_height=fit_height)
         scene = alignment.moved(scene, object_index(scene, align))
-    with without_huge_page_advice():
-        result = compute(scene, params)
+    result = compute(scene, params)
     report = dict(result.report)
     report["guards"] = {**report["guards"], "negative_input_pixels_clamped": negative}
     report["quality"] = quality

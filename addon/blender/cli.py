@@ -22,8 +22,8 @@ from typing import TYPE_CHECKING
 from .. import memory
 from ..callbacks import RunCallbacks
 from ..errors import DimredError
-from ..page_advice import without_huge_page_advice
 from ..quality import DEFAULT_QUALITY, DESCRIPTIONS, MIN_WORKING_WIDTH, PRESETS, working_width_problem
+from ..run_memory import run_memory
 from . import batch_cli, room_cli
 
 if TYPE_CHECKING:
@@ -126,7 +126,7 @@ def run_cli(argv: Sequence[str], *, blend_already_loaded: bool) -> int:
         return stop.code if isinstance(stop.code, int) else EXIT_BAD_INPUT
     try:
         # Reading and writing the panorama allocate as much as the removal does.
-        with without_huge_page_advice():
+        with run_memory():
             return args.run(args)
     except DimredError as error:
         # The contract is one line, whatever the message holds.

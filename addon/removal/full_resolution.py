@@ -10,7 +10,7 @@ and the difference written in bands of rows, into one float32 image.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -26,8 +26,8 @@ from .compose import ratio_change, reference_irradiance
 from .fill import Revealed, fill_hidden, hidden_light, hidden_planes, measured_reflectance, surface_footprint
 from .local import PointLight, Receiving, light_at
 from .object_window import ObjectWindow, object_window
+from .refine_samples import MIN_FACTOR, refine_samples
 from .relit_noise import relit_noise_stage
-from .ring_samples import MIN_FACTOR, ring_samples
 from .seam import seamless_block_change
 from .solution import Solution
 from .working_maps import Cells, WorkingMaps, cells, neighbours, surfaces_seen, working_maps
@@ -322,40 +322,77 @@ def _refine(solution: Solution, refine: _Refine, canvas: _Canvas, rep: Report, c
     keep[optional[np.argsort(-refine.spread[optional], kind="stable")[:budget]]] = True
     rep.info["refined_pixels"] = {"needed": int(needed.sum()), "sharp_edges": int(min(len(optional), budget)),
                                   "sharp_edges_left": int(max(0, len(optional) - budget))}
-    if (keep & refine.beside).any():
-        _ring_light(solution, refine.take(keep & refine.beside), canvas, rep, callbacks)
-    others = refine.take(keep & ~refine.beside)
-    if len(others.pixel):
-        light = _own_light(solution, others, canvas, rep, callbacks, per_point=False)
-        _write_light(solution, others, light.e, light.de, canvas, rep)
+    for beside in (True, False):
+        chosen = refine.take(keep & (refine.beside == beside))
+        if len(chosen.pixel):
+            _refined_light(solution, chosen, canvas, rep, callbacks, per_point=beside)
 
 
-def _ring_light(solution: Solution, ring: _Refine, canvas: _Canvas, rep: Report, callbacks: RunCallbacks) -> None:
-    """The light of the pixels beside the object, each at its own point; on a panorama
-    MIN_FACTOR or more times finer than the working copy from samples on every other pixel."""
+def _refined_light(solution: Solution, refine: _Refine, canvas: _Canvas, rep: Report, callbacks: RunCallbacks, *,
+                   per_point: bool) -> None:
+    """Write the change of the pixels `refine` from their own light; on a panorama MIN_FACTOR
+    or more times finer than the working copy from samples on every other pixel of them."""
     height, width = canvas.hdri.shape[:2]
-    window = canvas.window
-    if window is None or width < MIN_FACTOR * solution.traced.width:
-        light = _own_light(solution, ring, canvas, rep, callbacks, per_point=True)
-        _write_light(solution, ring, light.e, light.de, canvas, rep)
+    if width < MIN_FACTOR * solution.traced.width:
+        light = _own_light(solution, refine, canvas, rep, callbacks, per_point=per_point)
+        _write_light(solution, refine, light.e, light.de, canvas, rep)
         return
-    keys = solution.target.surface_key
-
-    def surface_at(rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
-        wr, wc, inside = window.holds(rows, cols)
-        usable = inside & ~window.hidden[wr, wc] & ~window.kept[wr, wc]
-        return surfaces_of(keys, np.where(usable, window.tri[wr, wc], -1))
-
-    samples = ring_samples(ring.pixel, width, height, surface_at)
-    wr, wc, _ = window.holds(*np.divmod(samples.computed, width))
-    n = len(samples.computed)
-    at = _Refine(samples.computed, window.tri[wr, wc].astype(np.int64), window.bary[wr, wc].astype(np.float64),
-                 window.distance[wr, wc].astype(np.float64), np.full(n, np.inf), np.ones(n, dtype=bool))
-    light = _own_light(solution, at, canvas, rep, callbacks, per_point=True)
-    rep.info["ring_samples"] = {"pixels": len(ring.pixel), "computed": n}
+    known = _Known(refine, canvas.window, solution.target.surface_key, width)
+    samples = refine_samples(refine.pixel, width, height, known.surface_at)
+    light = _own_light(solution, known.take(samples.computed), canvas, rep, callbacks, per_point=per_point)
+    counts = rep.info.setdefault("sampled_pixels", {"pixels": 0, "computed": 0})
+    counts["pixels"] += len(refine.pixel)
+    counts["computed"] += len(samples.computed)
     e = np.einsum("nk,nkc->nc", samples.weight, light.e[samples.corner])
     de = np.einsum("nk,nkc->nc", samples.weight, light.de[samples.corner])
-    _write_light(solution, ring, e, de, canvas, rep)
+    _write_light(solution, refine, e, de, canvas, rep)
+
+
+@dataclass(frozen=True)
+class _Known:
+    """What the pixels refined and those of the object's window see: the samples of the
+    refined pixels' light are taken among both (the window lets the pixels beside the object
+    take samples beyond their ring)."""
+
+    refine: _Refine
+    window: ObjectWindow | None
+    keys: np.ndarray  # the geometry's surface keys
+    width: int
+
+    def _among(self, flat: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Rows of `refine` holding the flat pixels, and whether it holds them."""
+        order = np.argsort(self.refine.pixel)
+        at = np.minimum(np.searchsorted(self.refine.pixel[order], flat), len(order) - 1)
+        return order[at], self.refine.pixel[order[at]] == flat
+
+    def _in_window(self, flat: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Window rows and columns of the flat pixels, and where it shows a surface for them."""
+        if self.window is None:
+            return np.zeros(len(flat), dtype=np.int64), np.zeros(len(flat), dtype=np.int64), np.zeros(len(flat), bool)
+        w = self.window
+        wr, wc, inside = w.holds(*np.divmod(flat, self.width))
+        return wr, wc, inside & ~w.hidden[wr, wc] & ~w.kept[wr, wc] & (w.tri[wr, wc] >= 0)
+
+    def surface_at(self, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+        flat = rows * self.width + cols
+        index, found = self._among(flat)
+        wr, wc, seen = self._in_window(flat)
+        tri = np.where(found, self.refine.tri[index], -1)
+        if self.window is not None:
+            tri = np.where(seen, self.window.tri[wr, wc], tri)
+        return surfaces_of(self.keys, tri)
+
+    def take(self, flat: np.ndarray) -> _Refine:
+        """The pixels `flat` (each refined or seen in the window) as pixels to compute."""
+        index, _ = self._among(flat)
+        chosen = self.refine.take(index)
+        wr, wc, seen = self._in_window(flat)
+        if not seen.any():
+            return chosen
+        w = self.window
+        return replace(chosen, pixel=flat, tri=np.where(seen, w.tri[wr, wc], chosen.tri),
+                       bary=np.where(seen[:, None], w.bary[wr, wc], chosen.bary),
+                       distance=np.where(seen, w.distance[wr, wc], chosen.distance))
 
 
 def _own_light(solution: Solution, refine: _Refine, canvas: _Canvas, rep: Report, callbacks: RunCallbacks, *,

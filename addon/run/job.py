@@ -34,10 +34,10 @@ from ..composition import on_earlier
 from ..errors import DimredError
 from ..geometry.mesh import to_probe_frame
 from ..io.exr import read_exr, write_exr
-from ..page_advice import without_huge_page_advice
 from ..pipeline import relocate_object, remove_object
 from ..quality import DEFAULT_QUALITY
 from ..relocation.fixedview import Move
+from ..run_memory import run_memory
 from ..scene import SceneData
 from ..segmentation.seen import SeenObject
 from ..segmentation.user_mask import UserMask
@@ -113,7 +113,7 @@ def run(request: RemovalRequest, callbacks: RunCallbacks = NO_CALLBACKS) -> Remo
     """Remove (or relocate) the requested object; `callbacks.preview` gets `preview.Preview`s:
     a quick fill first, then the engine's."""
     # Reading the panorama and writing the layer allocate as much as the removal does.
-    with without_huge_page_advice():
+    with run_memory():
         return _run(request, callbacks)
 
 

@@ -85,13 +85,13 @@ def test_an_object_across_the_seam(runs):
     assert up.report["hidden_region_filled"]
 
 
-def test_the_ring_sampled_on_every_other_pixel_follows_its_own_light(runs, monkeypatch):
-    # At 8K the ring is sampled (MIN_FACTOR working pixels); here at twice the working width.
+def test_refined_pixels_sampled_on_every_other_pixel_follow_their_own_light(runs, monkeypatch):
+    # At 8K the refined pixels are sampled (MIN_FACTOR working pixels); here at twice the working width.
     monkeypatch.setattr(full_resolution, "MIN_FACTOR", 2)
     sampled = remove_object(runs["scene"], "Box", working_width=W // 2)
     own = runs["working"]
-    assert "ring_samples" not in own.report
-    counts = sampled.report["ring_samples"]
+    assert "sampled_pixels" not in own.report
+    counts = sampled.report["sampled_pixels"]
     assert 0 < counts["computed"] < 0.6 * counts["pixels"]
     ring = latlong.dilate(own.hidden_mask, 3) & ~own.hidden_mask
     change = np.abs(own.difference[ring] @ LUMA).mean()

@@ -1,9 +1,9 @@
-"""Sampling the ring beside the object on every other pixel, from arrays."""
+"""Sampling the refined pixels on every other pixel, from arrays."""
 from __future__ import annotations
 
 import numpy as np
 
-from addon.removal.ring_samples import ring_samples
+from addon.removal.refine_samples import refine_samples
 
 W, H = 40, 20
 
@@ -16,13 +16,13 @@ def _mix(samples, values: np.ndarray) -> np.ndarray:
     return np.einsum("nk,nk->n", samples.weight, values.ravel()[samples.computed][samples.corner])
 
 
-def test_a_ring_on_one_surface_is_sampled_on_even_pixels_and_mixed_exactly_where_light_is_linear():
+def test_pixels_on_one_surface_is_sampled_on_even_pixels_and_mixed_exactly_where_light_is_linear():
     keys = np.zeros((H, W), dtype=np.int64)
     keys[8:12, 10:20] = -1  # the object
     rows, cols = np.nonzero(np.zeros((H, W), dtype=bool) | (np.abs(np.arange(H)[:, None] - 9.5) < 4.5)
                             & (np.abs(np.arange(W)[None, :] - 14.5) < 7.5) & (keys >= 0))
     pixel = rows * W + cols
-    samples = ring_samples(pixel, W, H, _surface(keys))
+    samples = refine_samples(pixel, W, H, _surface(keys))
     r, c = np.divmod(samples.computed, W)
     assert np.all((r % 2 == 0) & (c % 2 == 0))
     assert len(samples.computed) < 0.5 * len(pixel)
@@ -40,17 +40,17 @@ def test_samples_on_another_surface_are_never_mixed_and_a_pixel_without_any_is_i
     keys = np.zeros((H, W), dtype=np.int64)
     keys[:, 7] = 1  # a wall one column wide: its odd-column pixels have no even sample on it
     pixel = np.array([5 * W + 6, 5 * W + 7, 6 * W + 7, 5 * W + 8])
-    samples = ring_samples(pixel, W, H, _surface(keys))
+    samples = refine_samples(pixel, W, H, _surface(keys))
     r, c = np.divmod(samples.computed[samples.corner], W)
     used = samples.weight > 0
     assert np.all(keys[r[used], c[used]] == keys.ravel()[pixel][np.nonzero(used)[0]])
     assert 5 * W + 7 in samples.computed and 6 * W + 7 in samples.computed
 
 
-def test_the_ring_wraps_round_the_seam_and_stops_at_the_last_row():
+def test_the_samples_wrap_round_the_seam_and_stops_at_the_last_row():
     keys = np.zeros((H, W), dtype=np.int64)
     pixel = np.array([3 * W + W - 1, (H - 1) * W + 5])
-    samples = ring_samples(pixel, W, H, _surface(keys))
+    samples = refine_samples(pixel, W, H, _surface(keys))
     r, c = np.divmod(samples.computed[samples.corner[0]][samples.weight[0] > 0], W)
     assert set(c.tolist()) == {W - 2, 0} and set(r.tolist()) == {2, 4}
     r, c = np.divmod(samples.computed[samples.corner[1]][samples.weight[1] > 0], W)
