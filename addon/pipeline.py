@@ -14,7 +14,7 @@ from .alignment.fit import Alignment, align_object
 from .callbacks import NO_CALLBACKS, RunCallbacks
 from .errors import DimredError
 from .quality import DEFAULT_QUALITY, Params, params_for
-from .radiance import clamped_rows, negative_pixels, non_finite_pixels
+from .radiance import clamped_rows, negative_pixels, non_finite_pixels, round_to_stored_precision
 from .relocation.fixedview import Move
 from .relocation.insertion import relocate
 from .removal import RemovalResult, remove
@@ -60,6 +60,7 @@ def _run(scene: SceneData, quality: str, overrides: dict, compute: Callable[[Sce
         alignment = align_object(scene, align, params=params, fit_height=fit_height)
         scene = alignment.moved(scene, object_index(scene, align))
     result = compute(scene, params)
+    round_to_stored_precision(result.difference)
     report = dict(result.report)
     report["guards"] = {**report["guards"], "negative_input_pixels_clamped": negative}
     report["quality"] = quality

@@ -49,3 +49,27 @@ def _pixels_where(hdri: np.ndarray, some: Callable[[np.ndarray], bool], test: Ca
     which `some` (one reduction) says there are none is not tested pixel by pixel."""
     bands = (hdri[start:stop] for start, stop in row_bands(*hdri.shape[:2]))
     return sum(int(np.count_nonzero(test(band))) for band in bands if some(band))
+
+
+#: Mantissa bits the difference keeps (of float32's 23): a relative precision of 6e-5, eight
+#: times finer than a half-float panorama's own. The bits below are noise of the photograph
+#: times the light's ratio, which the file's lossless compression cannot shrink: at 8192 x 4096
+#: the difference's EXR was 222 MB and took 3.7 s of CPU to write, rounded 108 MB and 1.8 s.
+STORED_MANTISSA_BITS = 13
+
+
+def round_to_stored_precision(values: np.ndarray) -> np.ndarray:
+    """Round float32 `values` in place to STORED_MANTISSA_BITS, to nearest (ties away from
+    zero), band by band; returns them. Non-finite values stay non-finite."""
+    flat = values.reshape(-1)
+    if values.dtype != np.float32 or not values.flags.c_contiguous:
+        raise ValueError(f"expects a contiguous float32 array, got {values.dtype}")
+    dropped = 23 - STORED_MANTISSA_BITS
+    half, mask = np.uint32(1 << (dropped - 1)), np.uint32((0xFFFFFFFF << dropped) & 0xFFFFFFFF)
+    bits = flat.view(np.uint32)
+    for start in range(0, len(bits), _BAND_PIXELS):
+        band = bits[start:start + _BAND_PIXELS]
+        # A carry out of the mantissa raises the exponent: still the nearest value.
+        band += half
+        band &= mask
+    return values

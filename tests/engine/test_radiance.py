@@ -65,3 +65,20 @@ def test_all_finite_finds_one_non_finite_value_anywhere(bad):
     assert radiance.all_finite(values)
     values[19, 29, 2] = bad
     assert not radiance.all_finite(values)
+
+
+def test_the_difference_is_rounded_to_its_stored_precision_in_place():
+    from addon.radiance import STORED_MANTISSA_BITS, round_to_stored_precision
+
+    rng = np.random.default_rng(3)
+    values = (rng.standard_normal((64, 32, 3)) * 10.0 ** rng.uniform(-30, 30, (64, 32, 3))).astype(np.float32)
+    rounded = values.copy()
+    assert round_to_stored_precision(rounded) is rounded
+    relative = np.abs(rounded.astype(np.float64) / values - 1)
+    assert relative.max() <= 2.0 ** -(STORED_MANTISSA_BITS + 1)
+    assert np.all(rounded.view(np.uint32) & np.uint32((1 << (23 - STORED_MANTISSA_BITS)) - 1) == 0)
+    assert np.array_equal(round_to_stored_precision(rounded.copy()), rounded)  # already stored: unchanged
+    special = np.array([np.inf, -np.inf, np.nan, 0.0, 0.25, -1.5], np.float32)
+    out = round_to_stored_precision(special.copy())
+    assert np.isposinf(out[0]) and np.isneginf(out[1]) and np.isnan(out[2])
+    assert out[3:].tolist() == [0.0, 0.25, -1.5]
