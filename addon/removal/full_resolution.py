@@ -26,7 +26,7 @@ from .compose import ratio_change, reference_irradiance
 from .fill import Revealed, fill_hidden, hidden_light, hidden_planes, measured_reflectance, surface_footprint
 from .local import PointLight, Receiving, light_at
 from .object_window import ObjectWindow, object_window
-from .refine_samples import MIN_FACTOR, refine_samples
+from .refine_samples import refine_samples, sample_stride
 from .relit_noise import relit_noise_stage
 from .seam import seamless_block_change
 from .solution import Solution
@@ -330,15 +330,16 @@ def _refine(solution: Solution, refine: _Refine, canvas: _Canvas, rep: Report, c
 
 def _refined_light(solution: Solution, refine: _Refine, canvas: _Canvas, rep: Report, callbacks: RunCallbacks, *,
                    per_point: bool) -> None:
-    """Write the change of the pixels `refine` from their own light; on a panorama MIN_FACTOR
-    or more times finer than the working copy from samples on every other pixel of them."""
+    """Write the change of the pixels `refine` from their own light; on a panorama four or more
+    times finer than the working copy from samples at half the working pixel's pitch."""
     height, width = canvas.hdri.shape[:2]
-    if width < MIN_FACTOR * solution.traced.width:
+    stride = sample_stride(width // solution.traced.width)
+    if stride == 1:
         light = _own_light(solution, refine, canvas, rep, callbacks, per_point=per_point)
         _write_light(solution, refine, light.e, light.de, canvas, rep)
         return
     known = _Known(refine, canvas.window, solution.target.surface_key, width)
-    samples = refine_samples(refine.pixel, width, height, known.surface_at)
+    samples = refine_samples(refine.pixel, width, height, known.surface_at, stride=stride)
     light = _own_light(solution, known.take(samples.computed), canvas, rep, callbacks, per_point=per_point)
     counts = rep.info.setdefault("sampled_pixels", {"pixels": 0, "computed": 0})
     counts["pixels"] += len(refine.pixel)

@@ -3,12 +3,14 @@ and how the others mix it, when the panorama is much finer than the working copy
 
 Some pixels take their own light, not the working copy's upsampled: those beside the object
 (a contact shadow changes within one working pixel there) and those on a sharp shadow edge.
-At MIN_FACTOR or more panorama pixels a working pixel, neighbouring pixels lie a quarter of a
-working pixel apart or less, and their light differs by the little it changes over that step.
-So they are sampled on the pixels of even row and column: each pixel mixes the samples at
-most one pixel from it bilinearly, those among the refined pixels on its own surface, and a
-pixel with none (the end of a thin run, a corner of the room) is computed itself. The light
-there stays sampled at half the working pixel's pitch or finer, a quarter of the work at 8K.
+With four or more panorama pixels a working pixel, the light changes little from one pixel
+to the next. So it is sampled on the pixels whose row and column are multiples of a stride,
+half the working pixel's pitch (rounded down to a power of two: 2 at 4K, 4 at 8K from a 1K
+working copy): each pixel mixes the samples of its cell bilinearly, those among the refined
+pixels (or the object's window) on its own surface, and a pixel with none (the end of a
+thin run, a corner of the room) is computed itself. The light there stays sampled at half
+the working pixel's pitch or finer, twice as finely as the working copy's own pixels that
+get their own light, for a quarter of the work at 4K and a sixteenth at 8K.
 """
 from __future__ import annotations
 
@@ -16,9 +18,6 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-
-MIN_FACTOR = 4  # panorama pixels per working pixel from which the refined pixels are sampled
-_STRIDE = 2
 
 #: The surface key (n,) a pixel (rows, cols) shows where it can be a sample, -1 where not
 #: (not among the pixels refined).
@@ -36,14 +35,22 @@ class RefineSamples:
     weight: np.ndarray
 
 
-def refine_samples(pixel: np.ndarray, width: int, height: int, surface_at: SurfaceAt) -> RefineSamples:
-    """How the refined flat panorama pixels `pixel` (N,) take their light (see the module)."""
+def sample_stride(factor: int) -> int:
+    """The samples' spacing in panorama pixels at `factor` panorama pixels a working pixel: half
+    of it, rounded down to a power of two (1: every pixel is computed)."""
+    return 1 << max(0, (max(1, factor) // 2).bit_length() - 1)
+
+
+def refine_samples(pixel: np.ndarray, width: int, height: int, surface_at: SurfaceAt, *,
+                   stride: int) -> RefineSamples:
+    """How the refined flat panorama pixels `pixel` (N,) take their light from samples every
+    `stride` pixels (see the module)."""
     rows, cols = np.divmod(pixel, width)
     own = surface_at(rows, cols)
-    low_r, low_c = rows - rows % _STRIDE, cols - cols % _STRIDE
-    fy, fx = (rows % _STRIDE) / _STRIDE, (cols % _STRIDE) / _STRIDE
-    corner_r = np.stack([low_r, low_r, low_r + _STRIDE, low_r + _STRIDE], axis=1)
-    corner_c = np.mod(np.stack([low_c, low_c + _STRIDE, low_c, low_c + _STRIDE], axis=1), width)
+    low_r, low_c = rows - rows % stride, cols - cols % stride
+    fy, fx = (rows % stride) / stride, (cols % stride) / stride
+    corner_r = np.stack([low_r, low_r, low_r + stride, low_r + stride], axis=1)
+    corner_c = np.mod(np.stack([low_c, low_c + stride, low_c, low_c + stride], axis=1), width)
     weight = np.stack([(1 - fy) * (1 - fx), (1 - fy) * fx, fy * (1 - fx), fy * fx], axis=1)
     inside = corner_r < height
     keys = np.full(corner_r.shape, -1, dtype=np.int64)

@@ -86,8 +86,8 @@ def test_an_object_across_the_seam(runs):
 
 
 def test_refined_pixels_sampled_on_every_other_pixel_follow_their_own_light(runs, monkeypatch):
-    # At 8K the refined pixels are sampled (MIN_FACTOR working pixels); here at twice the working width.
-    monkeypatch.setattr(full_resolution, "MIN_FACTOR", 2)
+    # From 4K on the refined pixels are sampled; here at twice the working width, every other pixel.
+    monkeypatch.setattr(full_resolution, "sample_stride", lambda factor: 2)
     sampled = remove_object(runs["scene"], "Box", working_width=W // 2)
     own = runs["working"]
     assert "sampled_pixels" not in own.report

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from addon.removal.refine_samples import refine_samples
+from addon.removal.refine_samples import refine_samples, sample_stride
 
 W, H = 40, 20
 
@@ -22,7 +22,7 @@ def test_pixels_on_one_surface_is_sampled_on_even_pixels_and_mixed_exactly_where
     rows, cols = np.nonzero(np.zeros((H, W), dtype=bool) | (np.abs(np.arange(H)[:, None] - 9.5) < 4.5)
                             & (np.abs(np.arange(W)[None, :] - 14.5) < 7.5) & (keys >= 0))
     pixel = rows * W + cols
-    samples = refine_samples(pixel, W, H, _surface(keys))
+    samples = refine_samples(pixel, W, H, _surface(keys), stride=2)
     r, c = np.divmod(samples.computed, W)
     assert np.all((r % 2 == 0) & (c % 2 == 0))
     assert len(samples.computed) < 0.5 * len(pixel)
@@ -40,7 +40,7 @@ def test_samples_on_another_surface_are_never_mixed_and_a_pixel_without_any_is_i
     keys = np.zeros((H, W), dtype=np.int64)
     keys[:, 7] = 1  # a wall one column wide: its odd-column pixels have no even sample on it
     pixel = np.array([5 * W + 6, 5 * W + 7, 6 * W + 7, 5 * W + 8])
-    samples = refine_samples(pixel, W, H, _surface(keys))
+    samples = refine_samples(pixel, W, H, _surface(keys), stride=2)
     r, c = np.divmod(samples.computed[samples.corner], W)
     used = samples.weight > 0
     assert np.all(keys[r[used], c[used]] == keys.ravel()[pixel][np.nonzero(used)[0]])
@@ -50,8 +50,24 @@ def test_samples_on_another_surface_are_never_mixed_and_a_pixel_without_any_is_i
 def test_the_samples_wrap_round_the_seam_and_stops_at_the_last_row():
     keys = np.zeros((H, W), dtype=np.int64)
     pixel = np.array([3 * W + W - 1, (H - 1) * W + 5])
-    samples = refine_samples(pixel, W, H, _surface(keys))
+    samples = refine_samples(pixel, W, H, _surface(keys), stride=2)
     r, c = np.divmod(samples.computed[samples.corner[0]][samples.weight[0] > 0], W)
     assert set(c.tolist()) == {W - 2, 0} and set(r.tolist()) == {2, 4}
     r, c = np.divmod(samples.computed[samples.corner[1]][samples.weight[1] > 0], W)
     assert set(r.tolist()) == {H - 2} and set(c.tolist()) == {4, 6}
+
+
+def test_the_stride_is_half_the_working_pixel_rounded_down_to_a_power_of_two():
+    assert [sample_stride(f) for f in (1, 2, 3, 4, 6, 8, 12, 16)] == [1, 1, 1, 2, 2, 4, 4, 8]
+
+
+def test_a_wider_stride_mixes_the_cell_corners_bilinearly():
+    keys = np.zeros((H, W), dtype=np.int64)
+    pixel = np.array([5 * W + 6, 4 * W + 4])
+    samples = refine_samples(pixel, W, H, _surface(keys), stride=4)
+    r, c = np.divmod(samples.computed[samples.corner[0]], W)
+    assert set(zip(r.tolist(), c.tolist(), strict=True)) == {(4, 4), (4, 8), (8, 4), (8, 8)}
+    np.testing.assert_allclose(samples.weight[0], [0.75 * 0.5, 0.75 * 0.5, 0.25 * 0.5, 0.25 * 0.5])
+    linear = 0.3 * np.arange(H)[:, None] + 0.1 * np.arange(W)[None, :]
+    np.testing.assert_allclose(_mix(samples, linear), linear.ravel()[pixel])
+    assert samples.weight[1].tolist() == [1.0, 0.0, 0.0, 0.0]
