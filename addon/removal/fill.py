@@ -11,7 +11,7 @@ import numpy as np
 from ..callbacks import RunCallbacks
 from ..geometry import latlong
 from ..geometry.mesh import Geometry, surfaces_of
-from ..geometry.planeraster import edge_direction
+from ..geometry.planeraster import Frame, edge_direction
 from ..light.radiosity import LUMA, RHO_MAX
 from ..report import Report
 from ..synthesis.material import Material
@@ -154,9 +154,9 @@ def working_revealed(solution: Solution) -> Revealed:
     traced, behind = solution.traced, solution.traced.behind
     radiance = traced.panorama_rows(solution.hdri)
     pix = traced.hp[behind.revealed]
-    edges = _working_edges(solution)
+    edges = working_edges(solution)
     directions = traced.hits.directions.reshape(-1, 3)
-    tri, bary, points = _onto_photographed(edges, solution, directions[pix], behind.tri, behind.bary, behind.points)
+    tri, bary, points = onto_photographed(edges, solution, directions[pix], behind.tri, behind.bary, behind.points)
     solid = np.broadcast_to(latlong.pixel_solid_angles(traced.width, traced.height),
                             (traced.height, traced.width)).ravel()[pix]
     footprint = surface_footprint(solid, directions[pix], solution.geo.normals[tri], np.linalg.norm(points, axis=1))
@@ -173,25 +173,34 @@ def filled_surfaces(solution: Solution, revealed: Revealed) -> np.ndarray:
     return surface.reshape(traced.height, traced.width)
 
 
-# Pixels past the proxy's edge where a moved pixel takes its new surface's light: beside the corner.
+# Working pixels past the proxy's edge where a moved pixel takes its new surface's light: beside the corner.
 _ACROSS = 1.5
 
 
-def _working_edges(solution: Solution) -> SurfaceEdges:
+def working_edges(solution: Solution) -> SurfaceEdges:
     """The edges between the room's surfaces near the hole as the working panorama shows them."""
-    traced, geo = solution.traced, solution.geo
+    traced = solution.traced
     keys = solution.target.surface_key
     shape = (traced.height, traced.width)
     shows = np.full(traced.height * traced.width, -1, dtype=np.int64)
     shows[traced.hp] = keys[traced.tri_h]
+    return surface_edges(solution, np.asarray(solution.hdri), shows.reshape(shape),
+                         surfaces_of(keys, traced.behind.tri_without).reshape(shape), traced.hidden_map)
+
+
+def surface_edges(solution: Solution, photo: np.ndarray, shows: np.ndarray, behind: np.ndarray, hidden: np.ndarray,
+                  frame: Frame | None = None) -> SurfaceEdges:
+    """The edges between the room's surfaces near the `hidden` pixels as the photograph `photo`
+    (h, w, 3) shows them (`find_surface_edges`, over the pixels of `frame`, default the whole
+    panorama), the surface key each pixel `shows` and sees `behind` the object given (h, w)."""
+    geo, keys = solution.geo, solution.target.surface_key
     target = geo.tri_object == solution.target.index
     planes = {int(keys[t]): SurfacePlane(geo.normals[t], float(geo.normals[t] @ geo.triangles[t, 0]))
               for t in np.unique(keys, return_index=True)[1] if not target[t]}
-    return find_surface_edges(np.asarray(solution.hdri), shows.reshape(shape),
-                              surfaces_of(keys, traced.behind.tri_without).reshape(shape), traced.hidden_map, planes)
+    return find_surface_edges(photo, shows, behind, hidden, planes, frame=frame)
 
 
-def _onto_photographed(edges: SurfaceEdges, solution: Solution, directions: np.ndarray, tri: np.ndarray,
+def onto_photographed(edges: SurfaceEdges, solution: Solution, directions: np.ndarray, tri: np.ndarray,
                        bary: np.ndarray, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The revealed pixels' triangle, barycentric weights and point (unit `directions` (K, 3)),
     those the photograph shows on another surface than the proxy moved onto it: the point where
@@ -221,12 +230,43 @@ def _moved(edges: SurfaceEdges, solution: Solution, directions: np.ndarray, surf
     if not len(moved):
         return moved, np.zeros((0, 3)), moved, moved
     new = edges.assign(directions[moved], surface[moved])
-    near = edges.across(directions[moved], surface[moved], _ACROSS)
+    near = edges.across(directions[moved], surface[moved], _ACROSS * np.pi / traced.height)
     row, col = latlong.uv_to_pixel(*latlong.direction_to_uv(near), traced.width, traced.height)
     pixel = row * traced.width + col
     near_tri = traced.behind.tri_without[pixel]
     ok = surfaces_of(solution.target.surface_key, near_tri) == new
     return moved[ok], near[ok], near_tri[ok], pixel[ok]
+
+
+@dataclass(frozen=True)
+class Across:
+    """Seen pixels the photograph shows on the other side of a surface edge than the proxy: which
+    of those given (`index`), the surface they are on, their distance to it and their reflectance."""
+
+    index: np.ndarray  # (M,)
+    surface: np.ndarray  # (M,) surface key
+    distance: np.ndarray  # (M,)
+    rho: np.ndarray  # (M, 3)
+
+
+def moved_across(edges: SurfaceEdges, solution: Solution, directions: np.ndarray, surface: np.ndarray,
+                 radiance: np.ndarray) -> Across:
+    """Of the pixels that measure a reflectance (unit `directions` (K, 3) on `surface` (K,),
+    photographed `radiance` (K, 3)), those the photograph shows on another surface (`edges`): on
+    its plane, their irradiance that of the working pixel beside the proxy's corner on it (where
+    that one measures a reflectance), at any resolution."""
+    traced = solution.traced
+    moved, _, near_tri, near_pixel = _moved(edges, solution, directions, surface)
+    hit_row = np.full(traced.height * traced.width, -1, dtype=np.int64)
+    hit_row[traced.hp] = np.arange(len(traced.hp))
+    lit = hit_row[near_pixel]
+    ok = (lit >= 0) & working_measured(solution)[np.maximum(lit, 0)]
+    moved, lit, near_tri = moved[ok], lit[ok], near_tri[ok]
+    normal = solution.geo.normals[near_tri]
+    offset = np.einsum("ij,ij->i", normal, solution.geo.triangles[near_tri, 0])
+    distance = offset / np.einsum("ij,ij->i", directions[moved], normal)
+    rho = measured_reflectance(radiance[moved], solution.e_h[lit], np.ones(len(moved), dtype=bool))
+    return Across(index=moved, surface=solution.target.surface_key[near_tri], distance=distance, rho=rho)
 
 
 def _barycentric(points: np.ndarray, triangles: np.ndarray) -> np.ndarray:
@@ -281,20 +321,13 @@ def _panorama_reflectance(solution: Solution, radiance: np.ndarray, edges: Surfa
     rho[traced.hp] = measured_reflectance(radiance, e_h, measured)
     valid = np.zeros(n, dtype=bool)
     valid[traced.hp[measured]] = True
-    seen = np.flatnonzero(~traced.hidden_h)
-    directions = traced.hits.directions.reshape(-1, 3)[traced.hp[seen]]
-    moved, _, near_tri, near_pixel = _moved(edges, solution, directions, keys[traced.tri_h[seen]])
-    hit_row = np.full(n, -1, dtype=np.int64)
-    hit_row[traced.hp] = np.arange(len(traced.hp))
-    lit = hit_row[near_pixel]
-    ok = (lit >= 0) & measured[np.maximum(lit, 0)] & measured[seen[moved]]
-    rows, lit, near_tri = seen[moved[ok]], lit[ok], near_tri[ok]
-    pixel = traced.hp[rows]
-    surface_with[pixel] = surface_without[pixel] = keys[near_tri]
-    normal = solution.geo.normals[near_tri]
-    offset = np.einsum("ij,ij->i", normal, solution.geo.triangles[near_tri, 0])
-    distance_with[pixel] = distance_without[pixel] = offset / np.einsum("ij,ij->i", directions[moved[ok]], normal)
-    rho[pixel] = measured_reflectance(radiance[rows], e_h[lit], np.ones(len(rows), dtype=bool))
+    rows = np.flatnonzero(measured)
+    directions = traced.hits.directions.reshape(-1, 3)[traced.hp[rows]]
+    across = moved_across(edges, solution, directions, keys[traced.tri_h[rows]], radiance[rows])
+    pixel = traced.hp[rows[across.index]]
+    surface_with[pixel] = surface_without[pixel] = across.surface
+    distance_with[pixel] = distance_without[pixel] = across.distance
+    rho[pixel] = across.rho
     maps = PanoramaMaps(surface_with.reshape(shape), distance_with.reshape(shape), surface_without.reshape(shape),
                         distance_without.reshape(shape), traced.hidden_map)
     return PanoramaReflectance(rho.reshape(*shape, 3), valid.reshape(shape), maps)

@@ -148,14 +148,14 @@ class SurfaceEdges:
             out[move] = edge.surface_of(directions[move])
         return out
 
-    def across(self, directions: np.ndarray, surface: np.ndarray, pixels: float) -> np.ndarray:
+    def across(self, directions: np.ndarray, surface: np.ndarray, angle: float) -> np.ndarray:
         """(N, 3) for each of the unit `directions` (N, 3) on `surface` (N,) that `assign` moves,
-        the direction `pixels` past the proxy's edge on its new surface's side
+        the direction `angle` (radians) past the proxy's edge on its new surface's side
         (`SurfaceEdge.across`); the others as they are."""
         out = np.array(directions, copy=True)
         for edge in self.edges:
             move = edge.moved(directions) & ((surface == edge.first) | (surface == edge.second))
-            out[move] = edge.across(directions[move], pixels)
+            out[move] = edge.across(directions[move], angle * edge.scale)
         return out
 
 

@@ -103,13 +103,15 @@ def test_a_photograph_without_an_edge_keeps_the_proxys() -> None:
                                                                          "kept": "no edge found"}
 
 
-def test_the_fill_follows_the_photographs_wall_floor_line() -> None:
+@pytest.mark.parametrize("working_width", [WIDTH, WIDTH // 2], ids=["working", "full resolution"])
+def test_the_fill_follows_the_photographs_wall_floor_line(working_width: int) -> None:
     """Removed with the proxy's wall 0.2 m behind the photographed one, the hole's pixels between
-    the two lines show the wall as the truth does, not the floor's brown."""
+    the two lines show the wall as the truth does, not the floor's brown: filled on the working
+    panorama, and at the panorama's own size above the working width."""
     from addon.pipeline import remove_object
 
     photo, _ = _photograph(PHOTO_WALL)
-    result = remove_object(_scene(photo), "Box", quality="draft", segmentation_band=0)
+    result = remove_object(_scene(photo), "Box", quality="draft", segmentation_band=0, working_width=working_width)
     edited = photo + result.difference
     band = result.hidden_mask & (_labels(ROOM[1][0]) == 0) & (_labels(PHOTO_WALL) == 1)
     assert band.sum() >= 50
