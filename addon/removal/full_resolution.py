@@ -10,8 +10,6 @@ and the difference written in bands of rows, into one float32 image.
 """
 from __future__ import annotations
 
-import os
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -47,7 +45,6 @@ from .working_maps import Cells, WorkingMaps, cells, neighbours, surfaces_seen, 
 
 _BAND_PIXELS = 1 << 19  # full-resolution pixels per band (arrays of a few MB: reused, not mapped anew)
 _SHARP = 0.1  # neighbours whose dE / E differ by more than this leave the pixel to be refined
-_MAX_BAND_THREADS = 4  # bands upsampled at once, at most (each holds its temporaries)
 
 
 @dataclass(frozen=True)
@@ -187,8 +184,8 @@ def _upsample(solution: Solution, maps: WorkingMaps, canvas: _Canvas, rep: Repor
     e_map = maps.e.reshape(maps.height, maps.width, 3)
     de_map = maps.de.reshape(maps.height, maps.width, 3)
     band = max(1, _BAND_PIXELS // width)
-
-    def one_band(start: int) -> _Refine:
+    parts: list[_Refine] = []
+    for start in range(0, height, band):
         callbacks.check()
         rows = np.arange(start, min(start + band, height))
         y = (rows + 0.5) * (maps.height / height) - 0.5
@@ -234,14 +231,8 @@ def _upsample(solution: Solution, maps: WorkingMaps, canvas: _Canvas, rep: Repor
         if window_e is not None and len(pixels.window_index):
             window_e[pixels.window_rows, pixels.window_cols] = e[pixels.window_index]
         idx = np.flatnonzero(refine)
-        return _Refine(rows[0] * width + idx, pixels.tri[idx], pixels.bary[idx], pixels.distance[idx], spread[idx],
-                       pixels.ring[idx])
-
-    # Bands write disjoint rows and numpy lets go of the interpreter lock in their large
-    # operations, so they run side by side, one per core (8192 x 4096: 2.8 -> 1.x s on two).
-    starts = range(0, height, band)
-    with ThreadPoolExecutor(max_workers=max(1, min(os.cpu_count() or 1, _MAX_BAND_THREADS, len(starts)))) as pool:
-        parts = list(pool.map(one_band, starts))
+        parts.append(_Refine(rows[0] * width + idx, pixels.tri[idx], pixels.bary[idx], pixels.distance[idx],
+                             spread[idx], pixels.ring[idx]))
     return _Refine(*(np.concatenate([getattr(p, f) for p in parts]) for f in _Refine.__dataclass_fields__))
 
 
