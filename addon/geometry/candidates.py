@@ -37,18 +37,22 @@ def hits_among(directions: np.ndarray, triangles: np.ndarray, candidates: np.nda
 
 
 def _block(d: np.ndarray, triangles: np.ndarray, cand: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    t = triangles[np.maximum(cand, 0)]  # (n, K, 3, 3)
-    e1 = t[:, :, 1] - t[:, :, 0]
-    e2 = t[:, :, 2] - t[:, :, 0]
-    p = np.cross(d[:, None, :], e2)
-    det = np.einsum("nkc,nkc->nk", e1, p)
+    # By component on (n, K) arrays: np.cross and einsum on (n, K, 3) ones took twice as long
+    # for the same products, summed in the same order.
+    at = np.maximum(cand, 0)
+    v0x, v0y, v0z = (triangles[:, 0, c][at] for c in range(3))
+    ax, ay, az = (triangles[:, 1, c][at] - w for c, w in enumerate((v0x, v0y, v0z)))
+    bx, by, bz = (triangles[:, 2, c][at] - w for c, w in enumerate((v0x, v0y, v0z)))
+    dx, dy, dz = d[:, 0, None], d[:, 1, None], d[:, 2, None]
+    px, py, pz = dy * bz - dz * by, dz * bx - dx * bz, dx * by - dy * bx
+    det = ax * px + ay * py + az * pz
     with np.errstate(divide="ignore", invalid="ignore"):
         inv = 1.0 / det
-        s = -t[:, :, 0]  # the origin minus the first corner
-        b1 = np.einsum("nkc,nkc->nk", s, p) * inv
-        q = np.cross(s, e1)
-        b2 = np.einsum("nc,nkc->nk", d, q) * inv
-        dist = np.einsum("nkc,nkc->nk", e2, q) * inv
+        sx, sy, sz = -v0x, -v0y, -v0z  # the origin minus the first corner
+        b1 = (sx * px + sy * py + sz * pz) * inv
+        qx, qy, qz = sy * az - sz * ay, sz * ax - sx * az, sx * ay - sy * ax
+        b2 = (dx * qx + dy * qy + dz * qz) * inv
+        dist = (bx * qx + by * qy + bz * qz) * inv
     # A ray through a shared edge or corner belongs to some candidate: the small slack keeps
     # the seam between two triangles of one plane from leaking through.
     slack = 1e-9
