@@ -19,6 +19,7 @@ import secrets
 import struct
 import sys
 import tempfile
+import threading
 import zlib
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
@@ -301,30 +302,72 @@ def _library_call(path: str, verb: str, call: Callable[[], _T], errors: tuple[ty
 
 
 
-@contextlib.contextmanager
-def _captured_library_messages() -> Iterator[Callable[[], str]]:
-    """Capture what the OpenEXR library prints, so a bad file gives one error line, not three.
+class _Capture:
+    """What the OpenEXR library prints, captured so that a bad file gives one error line, not
+    three. The C core writes its diagnostics to file descriptor 2 and the binding warns through
+    Python's sys.stdout; both are redirected while any thread is inside a library call, and
+    handed back as text.
 
-    The C core writes its diagnostics to file descriptor 2 and the binding warns through
-    Python's sys.stdout; both are redirected for the duration and handed back as text.
+    Both are the process's own, so there is one redirection for all threads, counted: the
+    command line writes the difference on a second thread beside the edited panorama, and two
+    redirections of their own restored in the wrong order left sys.stdout captured and the
+    command's last line unprinted.
     """
-    captured_stdout = io.StringIO()
-    with tempfile.TemporaryFile(mode="w+b") as sink:
-        sys.stderr.flush()
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._inside = 0
+        self._text = io.StringIO()
+        self._sink: io.BufferedRandom | None = None
+        self._saved_fd: int | None = None
+        self._saved_stdout: object = None
+
+    @contextlib.contextmanager
+    def messages(self) -> Iterator[Callable[[], str]]:
+        with self._lock:
+            if not self._inside:
+                self._redirect()
+            self._inside += 1
+            sink, text = self._sink, self._text
+
+        def printed() -> str:
+            with self._lock:
+                return (_read_sink(sink) if sink is not None and not sink.closed else "") + text.getvalue()
+
         try:
-            saved_fd = os.dup(2)
+            yield printed
+        finally:
+            with self._lock:
+                self._inside -= 1
+                if not self._inside:
+                    self._restore()
+
+    def _redirect(self) -> None:
+        sys.stderr.flush()
+        self._text, self._saved_stdout = io.StringIO(), sys.stdout
+        sys.stdout = self._text
+        try:
+            self._saved_fd = os.dup(2)
         except OSError:
             # File descriptor 2 is closed (no console): only Python's output needs catching.
-            with contextlib.redirect_stdout(captured_stdout):
-                yield captured_stdout.getvalue
+            self._saved_fd = None
             return
-        os.dup2(sink.fileno(), 2)
-        try:
-            with contextlib.redirect_stdout(captured_stdout):
-                yield lambda: _read_sink(sink) + captured_stdout.getvalue()
-        finally:
-            os.dup2(saved_fd, 2)
-            os.close(saved_fd)
+        self._sink = tempfile.TemporaryFile(mode="w+b")
+        os.dup2(self._sink.fileno(), 2)
+
+    def _restore(self) -> None:
+        sys.stdout = self._saved_stdout
+        if self._saved_fd is not None:
+            os.dup2(self._saved_fd, 2)
+            os.close(self._saved_fd)
+            self._saved_fd = None
+        if self._sink is not None:
+            self._sink.close()
+            self._sink = None
+
+
+_CAPTURE = _Capture()
+_captured_library_messages = _CAPTURE.messages
 
 
 def _read_sink(sink: io.BufferedRandom) -> str:

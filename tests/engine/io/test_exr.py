@@ -360,3 +360,39 @@ def test_the_librarys_threads_are_started_once_and_left_as_set(monkeypatch):
     monkeypatch.setattr(exr.OpenEXR, "global_thread_count", lambda: 5)
     monkeypatch.setattr(exr.OpenEXR, "set_global_thread_count", lambda n: pytest.fail("reset the library's threads"))
     assert exr._codec_threads() == 5
+
+
+def test_library_calls_on_two_threads_leave_stdout_and_stderr_as_they_were(capfd):
+    import sys
+    import threading
+
+    stdout, fd2 = sys.stdout, os.fstat(2)
+    first_in, second_in, first_out = threading.Event(), threading.Event(), threading.Event()
+    texts = {}
+
+    def first():
+        with exr._captured_library_messages() as printed:
+            first_in.set()
+            second_in.wait(5)
+            print("from the first call")
+        first_out.set()
+        texts["first"] = printed
+
+    def second():
+        first_in.wait(5)
+        with exr._captured_library_messages() as printed:
+            second_in.set()
+            first_out.wait(5)  # the first call ends while this one is still inside
+            os.write(2, b"core message\n")
+            texts["second"] = printed()
+
+    threads = [threading.Thread(target=first), threading.Thread(target=second)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join(10)
+    assert sys.stdout is stdout
+    assert (os.fstat(2).st_ino, os.fstat(2).st_dev) == (fd2.st_ino, fd2.st_dev)
+    assert "core message" in texts["second"] and "from the first call" in texts["second"]
+    print("after")
+    assert capfd.readouterr().out == "after\n"
