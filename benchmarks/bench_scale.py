@@ -50,6 +50,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from addon.io import exr
+from addon.run_memory import run_memory
 from rendered import arguments
 from results import Table, write
 from scenes import metrics
@@ -307,26 +308,34 @@ def _profile(label: str, case: Case, run: Measured, engine: bool) -> str:
 def _floor(case: Case) -> str:
     """What one pass over the pixels of `case`'s panorama costs here, in this process: reading
     its EXR, one numpy pass (the edited panorama's sum of two images) and writing it as the
-    command line writes its results (the engine's reader and writer)."""
+    command line writes its results (the engine's reader and writer, with memory handed out as
+    a run has it: `run_memory`); and the sum into a new array under numpy's default huge-page
+    advice."""
     hdri = json.loads((case.folder / "case.json").read_text())["hdri"]
-    started = time.perf_counter()
-    image = exr.read_exr(case.folder / hdri)
-    read = time.perf_counter() - started
-    started = time.perf_counter()
-    out = image + image
-    add = time.perf_counter() - started
-    started = time.perf_counter()
-    np.add(image, image, out=out)
-    again = time.perf_counter() - started
-    with tempfile.TemporaryDirectory() as folder:
+    with run_memory():
         started = time.perf_counter()
-        exr.write_exr(Path(folder) / "pass.exr", out)
-        written = time.perf_counter() - started
+        image = exr.read_exr(case.folder / hdri)
+        read = time.perf_counter() - started
+        started = time.perf_counter()
+        out = image + image
+        add = time.perf_counter() - started
+        started = time.perf_counter()
+        np.add(image, image, out=out)
+        again = time.perf_counter() - started
+        with tempfile.TemporaryDirectory() as folder:
+            started = time.perf_counter()
+            exr.write_exr(Path(folder) / "pass.exr", out)
+            written = time.perf_counter() - started
+    del out
+    started = time.perf_counter()
+    advised = image + image
+    add_advised = time.perf_counter() - started
+    del advised
     pixels = image.shape[0] * image.shape[1]
     return (f"one pass over the {image.shape[1]}x{image.shape[0]} panorama ({pixels / 1e6:.1f} M float32 RGB pixels) "
-            f"here: reading its EXR {read:.2f} s; a numpy sum of two such images {add:.2f} s into a new array, "
-            f"{again:.2f} s into the same one again (this machine is slow to hand a process memory it has not "
-            f"touched yet); writing one EXR {written:.2f} s")
+            f"here, with memory as a run has it: reading its EXR {read:.2f} s; a numpy sum of two such images "
+            f"{add:.2f} s into a new array, {again:.2f} s into the same one again; writing one EXR {written:.2f} s. "
+            f"The same sum into a new array under numpy's default huge-page advice: {add_advised:.2f} s")
 
 
 def _ints(text: str) -> list[int]:
