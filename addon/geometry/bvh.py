@@ -83,9 +83,10 @@ def inverse(d: np.ndarray) -> np.ndarray:
 
 
 def boxes_crossed(q0: np.ndarray, inv: np.ndarray, tmin: np.ndarray, tmax: np.ndarray, lo: np.ndarray,
-                  hi: np.ndarray) -> np.ndarray:
+                  hi: np.ndarray, *, slack: float = 0.0) -> np.ndarray:
     """(N, B) whether segment q0 + t d, tmin <= t <= tmax, (inv = `inverse(d)`, all (N, ...))
-    meets box b, given by component: lo, hi (N or 1, 3, B)."""
+    meets box b, given by component: lo, hi (N or 1, 3, B); with `slack`, or comes within that
+    (in units of t) of meeting it."""
     near, far = tmin[:, None], tmax[:, None]
     for c in range(3):
         o, k = q0[:, c, None], inv[:, c, None]
@@ -93,7 +94,7 @@ def boxes_crossed(q0: np.ndarray, inv: np.ndarray, tmin: np.ndarray, tmax: np.nd
         b = (hi[:, c] - o) * k
         near = np.maximum(near, np.minimum(a, b))
         far = np.minimum(far, np.maximum(a, b))
-    return near <= far
+    return near <= far + slack
 
 
 def crossed(tree: Hierarchy, p0: np.ndarray, d: np.ndarray, q0: np.ndarray, inv: np.ndarray, tmin: np.ndarray,

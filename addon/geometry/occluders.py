@@ -16,6 +16,8 @@ from . import bvh, solid
 
 _SEG_CHUNK = 200_000
 _END_GAP = 30.0  # segment ends stop this many tolerances short of the surfaces they join
+_INV32 = np.float32(1e30)  # 1 / d held to this in float32 (bvh.inverse gives up to 1e200)
+_SLACK32 = np.float32(2e-6)  # the float32 box test's slack, in units of the segment
 
 
 @dataclass(frozen=True)
@@ -83,6 +85,7 @@ class Occluders:
         corners = [triangles[tri_object == k].reshape(-1, 3) for k in np.unique(tri_object)]
         self.lo = np.stack([c.min(axis=0) - eps for c in corners], axis=1)[None]
         self.hi = np.stack([c.max(axis=0) + eps for c in corners], axis=1)[None]
+        self._lo32, self._hi32 = self.lo.astype(np.float32), self.hi.astype(np.float32)
 
     def blocked(self, p0: np.ndarray, p1: np.ndarray) -> np.ndarray:
         """(N,) whether each open segment p0[i] -> p1[i] hits any triangle."""
@@ -99,7 +102,12 @@ class Occluders:
         tmin = np.minimum(_END_GAP * self.eps / np.maximum(length, 1e-300), 0.5)
         tmax = 1.0 - tmin
         inv = bvh.inverse(d)
-        near = bvh.boxes_crossed(p0, inv, tmin, tmax, self.lo, self.hi)
+        # Every segment against every object's box: in float32, 2.7x as fast. Its rounding is
+        # ten-millionths of the segment, so a box it passes within two millionths of is taken
+        # as met: an object more to test, never one less (the segments' ends stop short of
+        # their surfaces by more, so a lamp's housing is not taken for every ray to the lamp).
+        single = (np.asarray(a, dtype=np.float32) for a in (p0, np.clip(inv, -_INV32, _INV32), tmin, tmax))
+        near = bvh.boxes_crossed(*single, self._lo32, self._hi32, slack=_SLACK32)
         out = np.zeros(len(p0), dtype=bool)
         for k, obj in enumerate(self.objects):
             todo = np.flatnonzero(near[:, k] & ~out)
