@@ -18,8 +18,7 @@ from ..synthesis.material import Material
 from ..synthesis.plane_fill import FillOptions, HiddenPlane, PanoramaMaps, PanoramaReflectance, fill_surface
 from ..synthesis.surface_edges import SurfaceEdges, SurfacePlane, find_surface_edges
 from ..synthesis.texture import SynthesisParams
-from .interpolation import interpolate
-from .irradiance import fine_light
+from .irradiance import light_after
 from .room import MIN_COS
 from .solution import Solution
 
@@ -59,13 +58,13 @@ def hidden_light(solution: Solution, revealed: Revealed, callbacks: RunCallbacks
     """The irradiance after the removal at the revealed pixels (light transport: the report's
     stage `hidden_light`, apart from the synthesis that `fill_hidden` adds to it)."""
     room = solution.room
-    fine = fine_light(solution.lit, revealed.tri, revealed.bary, callbacks)
+    e_after = light_after(solution.lit, revealed.tri, revealed.bary, callbacks)
     patch, _, _ = room.patches.lattice.locate(revealed.tri, revealed.bary)
     emit = room.emitter[patch]
     emitted = np.zeros((len(patch), 3))
     # A light behind the object shines on with the radiosity its patch was given.
     emitted[emit] = room.senders.radiosity[patch[emit]] / np.pi
-    return HiddenLight(e_after=np.maximum(interpolate(fine.e_after, fine.corners, fine.weights), 0.0),
+    return HiddenLight(e_after=np.maximum(e_after, 0.0),
                        rho=room.rho[patch], emit=emit, emitted=emitted)
 
 

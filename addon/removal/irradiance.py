@@ -9,7 +9,7 @@ import numpy as np
 from ..callbacks import RunCallbacks
 from ..geometry.patches import build_lattice, levels_for_size
 from ..light.split import Split
-from .interpolation import inset
+from .interpolation import inset, interpolate
 from .lit_room import LitRoom
 from .room import Room
 
@@ -19,8 +19,13 @@ def before_and_after(room: Room, db: np.ndarray, split: Split, t: np.ndarray, t_
     """(E, E') at receivers with transport t, t_w from the patches and ts, ts_w from the split
     patches' sub-triangles (with and without the object): the room as photographed, and after
     removal with every bounce of the change db (P, 3)."""
-    rest = split.rest(room.senders.radiosity)
-    return t @ rest + ts @ split.b, t_w @ (rest + db) + ts_w @ (split.b + split.db)
+    return t @ split.rest(room.senders.radiosity) + ts @ split.b, _after(room, db, split, t_w, ts_w)
+
+
+def _after(room: Room, db: np.ndarray, split: Split, t_w: np.ndarray, ts_w: np.ndarray) -> np.ndarray:
+    """E' at receivers with transport t_w from the patches and ts_w from the split patches'
+    sub-triangles without the object (see `before_and_after`)."""
+    return t_w @ (split.rest(room.senders.radiosity) + db) + ts_w @ (split.b + split.db)
 
 
 @dataclass(frozen=True)
@@ -47,6 +52,34 @@ def fine_light(lit: LitRoom, tri: np.ndarray, bary: np.ndarray, callbacks: RunCa
     """Light at the vertices of a fine lattice (cells of about the target's `fine_cell`) over
     the triangles `tri`: only the vertices that the points (tri, bary) interpolate from;
     points farther than FAR_RADII object radii from it on one COARSER."""
+    lattice = _fine_lattice(lit, tri, bary)
+    callbacks.check()
+    return _light_of(lattice.vertices, lattice.normals, lit, lattice.corners, lattice.weights, callbacks)
+
+
+def light_after(lit: LitRoom, tri: np.ndarray, bary: np.ndarray, callbacks: RunCallbacks) -> np.ndarray:
+    """(N, 3) E' after the removal at the points (tri, bary), from the fine lattice of
+    `fine_light`: only the transport without the object is needed, so no ray is tested against
+    it (the points it hid, a third of the hotel photograph's hidden light)."""
+    lattice = _fine_lattice(lit, tri, bary)
+    callbacks.check()
+    occlusion, room, split = lit.occlusion, lit.room, lit.split
+    _, t_without = occlusion.transport_without(lattice.vertices, lattice.normals, room.senders, callbacks)
+    _, ts_without = occlusion.transport_without(lattice.vertices, lattice.normals, split.senders, callbacks)
+    return interpolate(_after(room, lit.db, split, t_without, ts_without), lattice.corners, lattice.weights)
+
+
+@dataclass(frozen=True)
+class _Lattice:
+    """The fine lattice's vertices (V, 3) and their normals, and where points find them."""
+
+    vertices: np.ndarray
+    normals: np.ndarray
+    corners: np.ndarray  # (N, 3) rows of the vertices each point interpolates
+    weights: np.ndarray  # (N, 3) their weights
+
+
+def _fine_lattice(lit: LitRoom, tri: np.ndarray, bary: np.ndarray) -> _Lattice:
     geo, target = lit.geo, lit.target
     v = geo.triangles[tri]
     points = v[:, 0] + bary[:, :1] * (v[:, 1] - v[:, 0]) + bary[:, 1:] * (v[:, 2] - v[:, 0])
@@ -67,8 +100,7 @@ def fine_light(lit: LitRoom, tri: np.ndarray, bary: np.ndarray, callbacks: RunCa
         corners[idx] = sum(map(len, vertices)) + inverse.reshape(at.shape)
         vertices.append(inset(fine.vertices[needed], geo.triangles[fine.vertex_tri[needed]]))
         normals.append(geo.normals[fine.vertex_tri[needed]])
-    callbacks.check()
-    return _light_of(np.concatenate(vertices), np.concatenate(normals), lit, corners, weights, callbacks)
+    return _Lattice(np.concatenate(vertices), np.concatenate(normals), corners, weights)
 
 
 def point_light(points: np.ndarray, normals: np.ndarray, lit: LitRoom, callbacks: RunCallbacks) -> FineLight:

@@ -28,6 +28,12 @@ class Occlusion:
         """(T, T') (R, S) from the senders to receivers (R, 3) with normals (R, 3)."""
         return transport(points, normals, senders, self.removed, self.others, callbacks.check)
 
+    def transport_without(self, points: np.ndarray, normals: np.ndarray, senders: Senders,
+                          callbacks: RunCallbacks) -> tuple[np.ndarray, np.ndarray]:
+        """(T, T') as `transport` gives them with the object left out of every ray: T' is the
+        same, T is T' with the senders on the object still sending (only T' is meant)."""
+        return transport(points, normals, senders, None, self.others, callbacks.check)
+
     def seen(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(N,) whether the probe (the origin) sees each point past the removed object, and
         (N,) whether it sees it at all."""
