@@ -61,12 +61,11 @@ STORED_MANTISSA_BITS = 13
 def round_to_stored_precision(values: np.ndarray) -> np.ndarray:
     """Round float32 `values` in place to STORED_MANTISSA_BITS, to nearest (ties away from
     zero), band by band; returns them. Non-finite values stay non-finite."""
-    flat = values.reshape(-1)
     if values.dtype != np.float32 or not values.flags.c_contiguous:
         raise ValueError(f"expects a contiguous float32 array, got {values.dtype}")
     dropped = 23 - STORED_MANTISSA_BITS
     half, mask = np.uint32(1 << (dropped - 1)), np.uint32((0xFFFFFFFF << dropped) & 0xFFFFFFFF)
-    bits = flat.view(np.uint32)
+    bits = values.reshape(-1).view(np.uint32)
     for start in range(0, len(bits), _BAND_PIXELS):
         band = bits[start:start + _BAND_PIXELS]
         # A carry out of the mantissa raises the exponent: still the nearest value.

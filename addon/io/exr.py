@@ -33,9 +33,9 @@ from ..errors import DimredError
 
 #: The most rows per band. The library holds Python's interpreter lock while it encodes or
 #: decodes a band, which stalls Blender's interface when the worker thread reads or writes, so
-#: a band holds about _BAND_PIXELS pixels per library thread (0.03 s); its rows are a multiple of the lines one
-#: chunk holds (32 for PIZ, which is written, and for B44 and DWAA; 16 for ZIP), so that no chunk
-#: is decoded twice except under DWAB's 256.
+#: a band holds about _BAND_PIXELS pixels per library thread (0.03 s); its rows are a multiple
+#: of the lines one chunk holds (32 for PIZ, which is written, and for B44 and DWAA; 16 for ZIP),
+#: so that no chunk is decoded twice except under DWAB's 256.
 BAND_ROWS = 256
 _BAND_PIXELS = 1 << 18
 #: The library's own threads, which encode or decode the chunks of one band side by side (it

@@ -11,6 +11,7 @@ and the difference written in bands of rows, into one float32 image.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from functools import cached_property
 
 import numpy as np
 
@@ -372,9 +373,14 @@ class _Known:
     keys: np.ndarray  # the geometry's surface keys
     width: int
 
+    @cached_property
+    def _order(self) -> np.ndarray:
+        """The rows of `refine` in the order of their pixels."""
+        return np.argsort(self.refine.pixel)
+
     def _among(self, flat: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Rows of `refine` holding the flat pixels, and whether it holds them."""
-        order = np.argsort(self.refine.pixel)
+        order = self._order
         at = np.minimum(np.searchsorted(self.refine.pixel[order], flat), len(order) - 1)
         return order[at], self.refine.pixel[order[at]] == flat
 

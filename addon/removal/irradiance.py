@@ -60,12 +60,12 @@ def fine_light(lit: LitRoom, tri: np.ndarray, bary: np.ndarray, callbacks: RunCa
 def light_after(lit: LitRoom, tri: np.ndarray, bary: np.ndarray, callbacks: RunCallbacks) -> np.ndarray:
     """(N, 3) E' after the removal at the points (tri, bary), from the fine lattice of
     `fine_light`: only the transport without the object is needed, so no ray is tested against
-    it (the points it hid, a third of the hotel photograph's hidden light)."""
+    the object (on the hotel photograph that halved the light at the points it hid)."""
     lattice = _fine_lattice(lit, tri, bary)
     callbacks.check()
     occlusion, room, split = lit.occlusion, lit.room, lit.split
-    _, t_without = occlusion.transport_without(lattice.vertices, lattice.normals, room.senders, callbacks)
-    _, ts_without = occlusion.transport_without(lattice.vertices, lattice.normals, split.senders, callbacks)
+    t_without = occlusion.transport_without(lattice.vertices, lattice.normals, room.senders, callbacks)
+    ts_without = occlusion.transport_without(lattice.vertices, lattice.normals, split.senders, callbacks)
     return interpolate(_after(room, lit.db, split, t_without, ts_without), lattice.corners, lattice.weights)
 
 

@@ -29,10 +29,10 @@ class Occlusion:
         return transport(points, normals, senders, self.removed, self.others, callbacks.check)
 
     def transport_without(self, points: np.ndarray, normals: np.ndarray, senders: Senders,
-                          callbacks: RunCallbacks) -> tuple[np.ndarray, np.ndarray]:
-        """(T, T') as `transport` gives them with the object left out of every ray: T' is the
-        same, T is T' with the senders on the object still sending (only T' is meant)."""
-        return transport(points, normals, senders, None, self.others, callbacks.check)
+                          callbacks: RunCallbacks) -> np.ndarray:
+        """T' (R, S) as `transport` gives it, with no ray tested against the object (T' never
+        meets it)."""
+        return transport(points, normals, senders, None, self.others, callbacks.check)[1]
 
     def seen(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(N,) whether the probe (the origin) sees each point past the removed object, and
