@@ -109,14 +109,14 @@ def _smooth_cells(points: np.ndarray, normals: np.ndarray, usable: np.ndarray, g
     table = np.zeros((-(-grid.height // cell) * cols, len(present)), dtype=bool)
     table[key[rows], column[senders]] = True
     cells = np.flatnonzero(table.any(axis=1))
-    # The cell's corner pixels, wrapping around in longitude; a cell past the last row has none.
+    # The cell's corner pixels, wrapping around in longitude; the cells of the last row close
+    # on the panorama's last row (their span is shorter), and one of a single row has none.
     r0, c0 = (cells // cols) * cell, (cells % cols) * cell
-    r1, c1 = r0 + cell, (c0 + cell) % grid.width
-    inside = r1 < grid.height
-    r1 = np.minimum(r1, grid.height - 1)
+    r1, c1 = np.minimum(r0 + cell, grid.height - 1), (c0 + cell) % grid.width
+    span = r1 - r0
     corner = row_of[np.stack([r0 * grid.width + c0, r0 * grid.width + c1, r1 * grid.width + c0,
                               r1 * grid.width + c1], axis=1)]
-    ok = inside & (corner >= 0).all(axis=1)
+    ok = (span > 0) & (corner >= 0).all(axis=1)
     corner = np.where(ok[:, None], corner, 0)
     ok &= usable[corner].all(axis=1)
 
@@ -134,27 +134,34 @@ def _smooth_cells(points: np.ndarray, normals: np.ndarray, usable: np.ndarray, g
     # middle pixel tells it from a shadow's edge or a bend, where the mix misses the middle.
     middle = row_of[np.minimum(r0 + cell // 2, grid.height - 1) * grid.width + (c0 + cell // 2) % grid.width]
     ask = ok & ~smooth & (middle >= 0)
-    ask[ask] = usable[middle[ask]] & _on_plane(points, normals, middle[ask], corner[ask])
+    ask[ask] = usable[middle[ask]] & _on_plane(points, normals, middle[ask], corner[ask]).all(axis=1)
     asked = ask[pair_cell]
     m_e, m_de = shadow(middle[pair_cell[asked]], present[pair_column[asked]])
-    half = np.array((cell // 2) / cell)  # the middle pixel's place in the cell, along each axis
-    mix = _bilinear(half, half)
-    missed_e = _sum_rows(pair_cell[asked], mix @ u_e[inverse[asked]] - m_e, len(cells)) @ LUMA
-    missed_de = _sum_rows(pair_cell[asked], mix @ u_de[inverse[asked]] - m_de, len(cells)) @ LUMA
+    # the middle pixel's place in its cell, along each axis
+    mix = _bilinear(np.minimum(cell // 2, span) / np.maximum(span, 1), np.array((cell // 2) / cell))
+    at_middle = mix[pair_cell[asked]]
+    missed_e = _sum_rows(pair_cell[asked], np.einsum("nk,nkc->nc", at_middle, u_e[inverse[asked]]) - m_e,
+                         len(cells)) @ LUMA
+    missed_de = _sum_rows(pair_cell[asked], np.einsum("nk,nkc->nc", at_middle, u_de[inverse[asked]]) - m_de,
+                          len(cells)) @ LUMA
     smooth |= ask & (np.maximum(np.abs(missed_e), np.abs(missed_de)) <= allowed)
     corner_e, corner_de = np.zeros((len(cells), 4, 3)), np.zeros((len(cells), 4, 3))
     for k in range(4):
         corner_e[:, k] = _sum_rows(pair_cell, u_e[inverse[:, k]], len(cells))
         corner_de[:, k] = _sum_rows(pair_cell, u_de[inverse[:, k]], len(cells))
 
-    # The points with pairs in smooth cells, on the plane of all four corners.
+    # The points with pairs in smooth cells take the corners on their own surface: in a cell
+    # across a wall's edge, whose corners agree, each side mixes its own; the corners of a
+    # cell taken for its gradient all lie on the middle's plane, and a point off it has none.
     p = np.unique(rows)
     p_cell = np.searchsorted(cells, key[p])
     p, p_cell = p[smooth[p_cell]], p_cell[smooth[p_cell]]
-    flat = _on_plane(points, normals, p, corner[p_cell])
-    p, p_cell = p[flat], p_cell[flat]
-    weights = _bilinear((r[p] - r0[p_cell]) / cell, ((c[p] - c0[p_cell]) % grid.width) / cell)
-    return _Served(p, p_cell, weights), corner_e, corner_de, len(unique) + int(asked.sum())
+    own = _on_plane(points, normals, p, corner[p_cell])
+    weights = own * _bilinear((r[p] - r0[p_cell]) / span[p_cell], ((c[p] - c0[p_cell]) % grid.width) / cell)
+    total = weights.sum(axis=1)
+    served = own.any(axis=1) & (total > 0)
+    weights = weights[served] / total[served, None]
+    return _Served(p[served], p_cell[served], weights), corner_e, corner_de, len(unique) + int(asked.sum())
 
 
 def _bilinear(fr: np.ndarray, fc: np.ndarray) -> np.ndarray:
@@ -164,11 +171,11 @@ def _bilinear(fr: np.ndarray, fc: np.ndarray) -> np.ndarray:
 
 
 def _on_plane(points: np.ndarray, normals: np.ndarray, p: np.ndarray, corners: np.ndarray) -> np.ndarray:
-    """(n,) whether points p (n,) lie on the plane of all their corners (n, 4): same normal, and
-    off each other's plane by a hair of their distance from the probe."""
+    """(n, 4) whether points p (n,) lie on the plane of each of their corners (n, 4): same
+    normal, and off each other's plane by a hair of their distance from the probe."""
     facing = np.einsum("nc,nkc->nk", normals[p], normals[corners]) >= _SAME_PLANE_COS
     off = np.abs(np.einsum("nc,nkc->nk", normals[p], points[corners] - points[p][:, None, :]))
-    return (facing & (off <= _SAME_PLANE_GAP * np.linalg.norm(points[p], axis=1)[:, None])).all(axis=1)
+    return facing & (off <= _SAME_PLANE_GAP * np.linalg.norm(points[p], axis=1)[:, None])
 
 
 def _sum_rows(rows: np.ndarray, values: np.ndarray, n: int) -> np.ndarray:

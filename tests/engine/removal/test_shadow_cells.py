@@ -93,23 +93,37 @@ def test_corners_that_disagree_by_less_than_the_budget_are_interpolated():
     assert loose.interpolated_points > strict.interpolated_points
 
 
-def test_a_pixel_is_never_interpolated_from_corners_on_another_surface():
+def test_a_pixel_takes_only_the_corners_on_its_own_surface():
     points, normals, grid = _floor(wall_from=10)
-    flat = lambda x, y: np.ones_like(x)  # noqa: E731
-    exact, _ = _run(points, normals, grid, flat, cell=1)
-    cells, _ = _run(points, normals, grid, flat, cell=4)
+    # Even on each surface, a step between them within the budget: the cells across the edge
+    # (columns 8-12) are smooth, and each side mixes its own corners.
+    per_surface = lambda x, y: np.where(x > 20.0, 1.5, 1.0)  # noqa: E731
+    exact, _ = _run(points, normals, grid, per_surface, cell=1)
+    cells, _ = _run(points, normals, grid, per_surface, cell=4, budget=2.0)
     np.testing.assert_allclose(cells.e, exact.e, atol=1e-12)
-    # Cells spanning columns 8-12 mix floor and wall: their pixels are all computed.
+    assert cells.interpolated_points == H * (W - 4)
+
+
+def test_a_shadow_that_differs_across_a_surface_edge_is_computed_there():
+    points, normals, grid = _floor(wall_from=10)
+    per_surface = lambda x, y: np.where(x > 20.0, 1.5, 1.0)  # noqa: E731
+    exact, _ = _run(points, normals, grid, per_surface, cell=1)
+    cells, _ = _run(points, normals, grid, per_surface, cell=4, budget=0.1)
+    np.testing.assert_allclose(cells.e, exact.e, atol=1e-12)
     assert cells.interpolated_points <= H * (W - 4) - H * 4
 
 
-def test_cells_that_do_not_divide_the_panorama_leave_its_last_rows_computed():
+def test_the_last_row_of_cells_closes_on_the_panoramas_last_row():
     points, normals, grid = _floor()
     steep = lambda x, y: 5.0 * x + 3.0 * y  # noqa: E731
     exact, _ = _run(points, normals, grid, steep, cell=1)
-    cells, _ = _run(points, normals, grid, steep, cell=3, budget=1e-6)
-    assert cells.interpolated_points > 0
-    np.testing.assert_allclose(cells.e, exact.e, atol=1e-9)
+    # Cells of 6 end in one of rows 12-15 (a span of 3), whose pixels are mixed as well; cells
+    # of 5 in one of row 15 alone, which has no corners below it. (Columns 18-19 of the cells
+    # of 6 take corners wrapped around to column 0, where the gradient is another.)
+    for cell, mixed in ((6, H * 18), (5, (H - 1) * 20)):
+        cells, _ = _run(points, normals, grid, steep, cell=cell, budget=1e-6)
+        np.testing.assert_allclose(cells.e, exact.e, atol=1e-9)
+        assert cells.interpolated_points == mixed
 
 
 def test_without_a_grid_every_pair_is_computed():
