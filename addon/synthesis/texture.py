@@ -32,6 +32,7 @@ import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 
 from ..errors import Cancelled, DimredError
+from .correlation import correlation, correlation_size, cross_spectrum, spectrum
 
 _BINOMIAL = (1 / 16, 4 / 16, 6 / 16, 4 / 16, 1 / 16)  # Python floats keep float32 arrays float32
 _EXACT = 2**24 - 1  # float32 holds every integer up to this
@@ -644,19 +645,17 @@ def _rank_offsets(image: np.ndarray, ring: np.ndarray, hole: np.ndarray, ex: np.
     of the ring lands on valid exemplar and a quarter as much of the hole lands on window centres
     as under the best-covering shift; picked shifts suppress their 3 x 3 neighbours."""
     (h, w), (eh, ew) = ring.shape, ex_valid.shape
-    size = (h + eh, w + ew)
-
-    def corr(a, b):  # sum_x a(x) b(x + t), summed over channels, indexed by t mod size
-        fa = np.fft.rfft2(a, s=size, axes=(0, 1))
-        fb = np.fft.rfft2(b, s=size, axes=(0, 1))
-        c = np.fft.irfft2(np.conj(fa) * fb, s=size, axes=(0, 1))
-        return c.sum(axis=2) if c.ndim == 3 else c
-
-    r, v = ring.astype(np.float64), ex_valid.astype(np.float64)
+    size = correlation_size((h, w), (eh, ew))
     img, exv = np.where(ring[..., None], image, 0).astype(np.float64), np.where(ex_valid[..., None], ex, 0)
-    num = corr((img ** 2).sum(axis=2), v) + corr(r, (exv.astype(np.float64) ** 2).sum(axis=2)) - 2 * corr(img, exv)
-    cnt = np.rint(corr(r, v))
-    cover = np.rint(corr(hole.astype(np.float64), centres.astype(np.float64)))
+    exv = exv.astype(np.float64)
+    f_ring, f_valid = spectrum(ring.astype(np.float64), size), spectrum(ex_valid.astype(np.float64), size)
+    # the ring's sum of image^2 + ex^2 - 2 image.ex under each shift, transformed back once
+    num = correlation(cross_spectrum(spectrum((img ** 2).sum(axis=2), size), f_valid)
+                      + cross_spectrum(f_ring, spectrum((exv ** 2).sum(axis=2), size))
+                      - 2 * cross_spectrum(spectrum(img, size), spectrum(exv, size)), size)
+    cnt = np.rint(correlation(cross_spectrum(f_ring, f_valid), size))
+    cover = np.rint(correlation(cross_spectrum(spectrum(hole.astype(np.float64), size),
+                                               spectrum(centres.astype(np.float64), size)), size))
     ty, tx = np.arange(-(h - 1), eh), np.arange(-(w - 1), ew)
     grid = np.ix_(ty % size[0], tx % size[1])
     num, cnt, cover = num[grid], cnt[grid], cover[grid]

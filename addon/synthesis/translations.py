@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..segmentation.masks import box_mean
+from .correlation import correlation, correlation_size, cross_spectrum, spectrum
 
 _COARSE_SIDE = 160  # the FFT runs on a copy at most this many blocks across: a few ms
 _MIN_OVERLAP = 0.2  # a shift counts where this share of the known pixels stays known under it
@@ -112,18 +113,15 @@ def _self_difference(values: np.ndarray, valid: np.ndarray) -> tuple[np.ndarray,
     """D(t) for every shift t of an (h, w) image, indexed from -(h-1), -(w-1); and how many
     pixel pairs each mean is over."""
     h, w = values.shape
-    size = (2 * h, 2 * w)
-    m = valid.astype(np.float64)
+    size = correlation_size((h, w), (h, w))
     v = np.where(valid, values, 0.0)
-
-    def corr(a: np.ndarray, b: np.ndarray) -> np.ndarray:  # sum_x a(x) b(x + t)
-        c = np.fft.irfft2(np.conj(np.fft.rfft2(a, s=size)) * np.fft.rfft2(b, s=size), s=size)
-        return c[np.ix_(np.arange(-(h - 1), h) % size[0], np.arange(-(w - 1), w) % size[1])]
-
-    count = np.rint(corr(m, m))
-    sq = corr(v * v, m)
-    # sum over pairs of a(x)^2 + a(x+t)^2 - 2 a(x) a(x+t); sq(-t) is the second term
-    num = sq + sq[::-1, ::-1] - 2 * corr(v, v)
+    f_valid, f_values = spectrum(valid.astype(np.float64), size), spectrum(v, size)
+    shifts = np.ix_(np.arange(-(h - 1), h) % size[0], np.arange(-(w - 1), w) % size[1])
+    count = np.rint(correlation(cross_spectrum(f_valid, f_valid), size))[shifts]
+    # sum over pairs of a(x)^2 + a(x+t)^2 - 2 a(x) a(x+t)
+    f_squares = spectrum(v * v, size)
+    num = correlation(cross_spectrum(f_squares, f_valid) + cross_spectrum(f_valid, f_squares)
+                      - 2 * cross_spectrum(f_values, f_values), size)[shifts]
     return np.maximum(num, 0.0) / np.maximum(count, 1), count
 
 
