@@ -23,9 +23,10 @@ def reference_irradiance(e: np.ndarray, apply: np.ndarray) -> float:
 
 
 def ratio_change(radiance: np.ndarray, e: np.ndarray, de: np.ndarray, apply: np.ndarray, *, e_ref: float,
-                 rep: Report) -> np.ndarray:
+                 rep: Report, out: np.ndarray | None = None) -> np.ndarray:
     """(N, 3) change of the radiance (N, 3) of pixels with irradiance E and change dE (N, 3)
-    where `apply`, else 0.
+    where `apply`, else 0; written into `out` (N, 3) when given (a band of the full-resolution
+    difference, so it is not copied there afterwards).
 
     Where E is ~0 (against `e_ref`) the ratio means nothing and the pixel is left; where the
     pixel implies a reflectance above RHO_MAX, E is taken as large as that bound allows (a
@@ -44,7 +45,7 @@ def ratio_change(radiance: np.ndarray, e: np.ndarray, de: np.ndarray, apply: np.
     over = floor > e_eff
     rep.guard("reflectance_clamped_pixels", np.count_nonzero(apply & (over[:, 0] | over[:, 1] | over[:, 2])))
     np.maximum(e_eff, floor, out=e_eff)
-    d = radiance * de
+    d = np.multiply(radiance, de, out=out)
     d /= e_eff
     d[np.flatnonzero(~apply)] = 0.0
     black = np.negative(radiance, out=floor)

@@ -207,11 +207,15 @@ def _upsample(solution: Solution, maps: WorkingMaps, canvas: _Canvas, rep: Repor
         plain = np.take(grid.plain[pair], col, axis=1).ravel()
         cell_spread = np.take(grid.spread[pair], col, axis=1).ravel()
         sharp = plain & (cell_spread > _SHARP)
-        cell_key = np.take(maps.key.reshape(maps.height, maps.width)[top[pair]], col, axis=1).ravel()
         pixels = _BandPixels.of(rows, width, window, solution.target.surface_key)
         # The pixels the cells cannot serve as they are: those of a mixed cell, and in the
-        # window those hidden, beside the object or on another surface than their cell's.
-        fast = plain & ~pixels.hidden & ~pixels.ring & ((pixels.own == cell_key) | ~pixels.known)
+        # window those hidden, beside the object or on another surface than their cell's
+        # (only the window's pixels are known yet: the rest of the band is left as it is).
+        fast = plain.copy()
+        inside = pixels.window_index
+        if len(inside):
+            cell_key = maps.key.reshape(maps.height, maps.width)[top[pair][inside // width], col[inside % width]]
+            fast[inside] &= ~pixels.hidden[inside] & ~pixels.ring[inside] & (pixels.own[inside] == cell_key)
         slow = np.flatnonzero(~fast & ~pixels.hidden)
         served = fast.copy()
         refine = np.zeros(len(plain), dtype=bool)
@@ -225,10 +229,11 @@ def _upsample(solution: Solution, maps: WorkingMaps, canvas: _Canvas, rep: Repor
         # Sharp edges are refined where the pixel's surface is known (looked up if need be).
         sharp &= fast
         pixels.look_up(solution, maps, rows, width, height, np.flatnonzero(sharp & ~pixels.known))
-        refine |= sharp & (pixels.tri >= 0)
+        at = np.flatnonzero(sharp)
+        refine[at[pixels.tri[at] >= 0]] = True
         radiance = clamped_rows(hdri, rows[0], rows[-1] + 1).reshape(-1, 3)
-        d = ratio_change(radiance, e, de, served, e_ref=canvas.e_ref, rep=rep)
-        difference[rows[0]:rows[-1] + 1] = d.reshape(-1, width, 3)
+        ratio_change(radiance, e, de, served, e_ref=canvas.e_ref, rep=rep,
+                     out=difference[rows[0]:rows[-1] + 1].reshape(-1, 3))
         if window_e is not None and len(pixels.window_index):
             window_e[pixels.window_rows, pixels.window_cols] = e[pixels.window_index]
         idx = np.flatnonzero(refine)
@@ -258,7 +263,7 @@ class _BandPixels:
     def of(cls, rows: np.ndarray, width: int, window: ObjectWindow | None, keys: np.ndarray) -> _BandPixels:
         n = len(rows) * width
         pixels = cls(np.zeros(n, dtype=bool), np.zeros(n, dtype=bool), np.zeros(n, dtype=bool),
-                     np.full(n, -1, dtype=np.int64), np.full(n, -1, dtype=np.int64), np.zeros((n, 2)), np.zeros(n),
+                     np.full(n, -1, dtype=np.int32), np.full(n, -1, dtype=np.int32), np.zeros((n, 2)), np.zeros(n),
                      np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), keys)
         if window is None:
             return pixels
