@@ -16,7 +16,7 @@ from addon.callbacks import NO_CALLBACKS, RunCallbacks
 from addon.errors import Cancelled, DimredError
 from addon.light.radiosity import LUMA, RHO_MAX
 from addon.quality import params_for
-from addon.removal import finish, irradiance, solve_lighting
+from addon.removal import fill, finish, irradiance, solve_lighting
 from addon.removal.compose import compose
 from addon.removal.fill import fill_hidden, hidden_light, working_revealed
 from addon.removal.first_order import first_order
@@ -217,6 +217,28 @@ def test_fill_gives_the_revealed_floor_positive_light_and_shows_its_progress(sta
     filled = solution.traced.panorama_rows(solution.hdri)[revealed] + change
     assert (filled >= 0).all() and (filled @ LUMA).mean() > 0
     assert len(shown) >= 2 and np.array_equal(shown[-1], change)
+
+
+def test_planes_filled_side_by_side_give_what_they_give_one_after_the_other(stages, monkeypatch):
+    solution = stages["solution"]
+    revealed_pixels = working_revealed(solution)
+    light = hidden_light(solution, revealed_pixels, NO_CALLBACKS)
+    planes = fill.hidden_planes(solution.geo, solution.target.surface_key, revealed_pixels.tri,
+                                revealed_pixels.points)
+
+    def halves(*args):
+        """Each plane as two, its points split in half: two fills of one surface at least."""
+        return [(sel[part], dataclasses.replace(plane, points=plane.points[part]))
+                for sel, plane in planes for part in np.array_split(np.arange(len(sel)), 2)]
+
+    monkeypatch.setattr(fill, "hidden_planes", halves)
+    side_by_side, reported = Report(), Report()
+    together = fill.fill_hidden(solution, revealed_pixels, light, side_by_side, NO_CALLBACKS)
+    in_turn = fill.fill_hidden(solution, revealed_pixels, light, reported, NO_CALLBACKS, lambda change: None)
+    assert len(side_by_side.info["filled_surfaces"]) >= 2
+    np.testing.assert_array_equal(together, in_turn)
+    strip = [{k: v for k, v in s.items() if k != "seconds"} for s in side_by_side.info["filled_surfaces"]]
+    assert strip == [{k: v for k, v in s.items() if k != "seconds"} for s in reported.info["filled_surfaces"]]
 
 
 def test_finish_adds_the_difference_to_the_panorama_and_masks_the_object(stages):
