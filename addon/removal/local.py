@@ -3,6 +3,7 @@ the coarse lattice, from a fine lattice near the object, and per pixel where the
 shadows an important sender."""
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -19,7 +20,7 @@ from .interpolation import interpolate
 from .irradiance import before_and_after, fine_light, point_light
 from .lit_room import LitRoom
 from .room import Room
-from .shadow_cells import PixelGrid, cell_shadows
+from .shadow_cells import PairShadow, PixelGrid, cell_shadows
 from .significance import significant
 from .target import Target
 from .trace import Traced
@@ -114,21 +115,28 @@ def light_at(lit: LitRoom, receiving: Receiving, params: Params, callbacks: RunC
     de_h = interpolate(change(e_v, ea_v, room.t_with, room.t_without), corners_h, weights_h)
 
     candidate = np.flatnonzero(receiving.relit)  # the points that may be relit
-    sig = significant(room.senders, imp, receiving.points[candidate], e_h[candidate], target, params)
     near = neighbourhood(receiving.points[candidate], target.centre, target.radius, reach=params.reach)
+    # Base for the pixel: the coarse lattice, or near the object a fine one (only the
+    # vertices the pixels use): the split patches' sub-triangles beside the object light
+    # the pixels near them unevenly, which coarse vertices would smear over a coarse patch.
+    # It is computed on a second thread while the significant pairs are found.
+    near_pixels = candidate[near]
+    with ThreadPoolExecutor(max_workers=1) as pool:
+        pending = None
+        if len(near_pixels) and per_point:
+            pending = pool.submit(point_light, receiving.points[near_pixels], receiving.normals[near_pixels], lit,
+                                  callbacks)
+        elif len(near_pixels):
+            pending = pool.submit(fine_light, lit, receiving.tri[near_pixels], receiving.bary[near_pixels], callbacks)
+        sig = significant(room.senders, imp, receiving.points[candidate], e_h[candidate], target, params)
+        fine = None if pending is None else pending.result()
     affected = int((sig.any(axis=1) | near).sum())
     if not (sig.any() or near.any()):
         return PointLight(e_h, de_h, affected, 0, 0)
 
-    # Base for the pixel: the coarse lattice, or near the object a fine one (only the
-    # vertices the pixels use): the split patches' sub-triangles beside the object light
-    # the pixels near them unevenly, which coarse vertices would smear over a coarse patch.
-    near_pixels = candidate[near]
     fine_vertices = 0
     fine_row = np.full(len(receiving.points), -1)
-    if len(near_pixels):
-        fine = (point_light(receiving.points[near_pixels], receiving.normals[near_pixels], lit, callbacks)
-                if per_point else fine_light(lit, receiving.tri[near_pixels], receiving.bary[near_pixels], callbacks))
+    if fine is not None:
         fine_vertices = len(fine.t_with)
         e_h[near_pixels] = interpolate(fine.e, fine.corners, fine.weights)
         de_h[near_pixels] = interpolate(change(fine.e, fine.e_after, fine.t_with, fine.t_without), fine.corners,
@@ -159,7 +167,29 @@ def light_at(lit: LitRoom, receiving: Receiving, params: Params, callbacks: RunC
     pair_row, pair_sender = np.nonzero(sig)
     shadows = cell_shadows(receiving.points, receiving.normals, receiving.relit, receiving.grid,
                            candidate[pair_row], imp[pair_sender], params.significance * np.maximum(e_h @ LUMA, 0.0),
-                           shadow, cell=target.shadow_cell)
+                           _on_two_threads(shadow), cell=target.shadow_cell)
     return PointLight(e_h + shadows.e, de_h + shadows.de, affected, fine_vertices, len(pair_row),
                       shadows.interpolated_points, shadows.computed_pairs,
                       tuple(groups.sizes[groups.sizes > 1].tolist()))
+
+
+_THREADED_PAIRS = 20_000  # fewer pairs are computed on one thread: starting a second costs more
+
+
+def _on_two_threads(shadow: PairShadow) -> PairShadow:
+    """`shadow` computed on two threads, its pairs split between them by receiving point (a
+    point's pairs stay together: they share its emitters' budget of rays): the same values.
+    A window-lit room has hundreds of thousands of pairs to trace here, the box's lamps a few."""
+
+    def split(pix: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        first = pix <= np.median(pix) if len(pix) >= _THREADED_PAIRS else np.ones(len(pix), dtype=bool)
+        if first.all():
+            return shadow(pix, s)
+        with ThreadPoolExecutor(max_workers=1) as pool:
+            pending = pool.submit(shadow, pix[~first], s[~first])
+            e, de = np.empty((len(pix), 3)), np.empty((len(pix), 3))
+            e[first], de[first] = shadow(pix[first], s[first])
+            e[~first], de[~first] = pending.result()
+        return e, de
+
+    return split
