@@ -4,6 +4,7 @@ It is written as report.json next to the images and shown in Blender's panel.
 """
 from __future__ import annotations
 
+import threading
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -21,6 +22,7 @@ class Report:
         self._progress = progress
         self._stages = max(stages, 1)
         self._start = time.perf_counter()
+        self._lock = threading.Lock()  # a stage's threads may count guards at once
 
     @contextmanager
     def stage(self, name: str) -> Iterator[None]:
@@ -39,7 +41,8 @@ class Report:
         self.warnings.append(message)
 
     def guard(self, name: str, count: int) -> None:
-        self.guards[name] = self.guards.get(name, 0) + int(count)
+        with self._lock:
+            self.guards[name] = self.guards.get(name, 0) + int(count)
 
     def as_dict(self) -> dict:
         seconds = {k: round(v, 4) for k, v in self.seconds.items()}

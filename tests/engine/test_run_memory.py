@@ -48,9 +48,10 @@ def test_malloc_keeps_freed_memory_during_the_run_and_gives_it_back_after(monkey
     libc = _Libc()
     monkeypatch.setattr(memory_module, "_glibc", lambda: libc)
     with pytest.raises(RuntimeError), run_memory():
-        assert libc.calls == [("mallopt", -1, 1 << 30), ("mallopt", -3, 32 << 20)]
+        # and every thread takes its memory from the one heap
+        assert libc.calls == [("mallopt", -1, 1 << 30), ("mallopt", -3, 32 << 20), ("mallopt", -8, 1)]
         raise RuntimeError("cancelled")
-    assert libc.calls[2:] == [("mallopt", -1, 128 << 10), ("malloc_trim", 0)]
+    assert libc.calls[3:] == [("mallopt", -1, 128 << 10), ("mallopt", -8, 0), ("malloc_trim", 0)]
 
 
 def test_without_glibc_or_numpy_switch_the_body_runs(monkeypatch) -> None:
