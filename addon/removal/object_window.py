@@ -2,6 +2,7 @@
 what they reveal once it is gone, and the surfaces the fill's exemplar is read from."""
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -19,6 +20,7 @@ _PAD = 4  # working pixels the window reaches past what it must hold
 _MAX_PIXELS = 2 << 20  # the largest window (its arrays and the fill's maps take ~120 bytes a pixel)
 _RING = 3  # full-resolution pixels beside the object always get their own light
 _BLOCK_PIXELS = 1 << 19  # pixels looked up at a time (bounds the candidates' temporaries)
+_BLOCK_THREADS = 2  # blocks looked up at once
 
 
 @dataclass(frozen=True)
@@ -84,13 +86,19 @@ def object_window(geo: Geometry, target: Target, hidden_working: np.ndarray, cov
     bary = np.empty((*shape, 2), dtype=np.float32)
     cols_full = np.mod(col_start + np.arange(ncols), width)
     block = max(1, _BLOCK_PIXELS // ncols)
-    for start in range(0, shape[0], block):
+
+    def look_up(start: int) -> None:
+        """What the block of rows from `start` sees, written into its rows."""
         rows_b = row_start + np.arange(start, min(start + block, shape[0]))
         near = neighbours(np.repeat(rows_b, ncols), np.tile(cols_full, len(rows_b)), full, maps)
         found = surfaces_seen(directions[start:start + len(rows_b)].reshape(-1, 3), near.nearest, geo, maps)
         tri[start:start + len(rows_b)] = found.tri.reshape(-1, ncols)
         distance[start:start + len(rows_b)] = found.distance.reshape(-1, ncols)
         bary[start:start + len(rows_b)] = found.bary.reshape(-1, ncols, 2)
+
+    # Two blocks at a time, each writing rows of its own (an 8K window is millions of pixels).
+    with ThreadPoolExecutor(max_workers=_BLOCK_THREADS) as pool:
+        list(pool.map(look_up, range(0, shape[0], block)))
     on_object = object_distance < distance
     frame = Frame(row_start, col_start, height, width)
     hidden = latlong.dilate(on_object if seen is None else seen.in_frame(frame, shape), 1)

@@ -8,6 +8,7 @@ an area-averaged copy when it would exceed `_MAX_PIXELS` (a close object in a 16
 """
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -121,8 +122,11 @@ def seen_object(hdri: np.ndarray, geo: Geometry, index: int, *, segment: bool = 
     band_px = max(_MIN_BAND, int(np.ceil(band_full / factor)))
     frame, shape = _window(spot, band_px + _PAD, hs, ws)
     window = (frame.row0, shape[0], frame.col0, shape[1])
-    obj = trace_panorama(geo.triangles[on], ws, hs, window=window)
-    others = trace_panorama(geo.triangles[~on], ws, hs, window=window)
+    # The object and the rest are traced side by side (at 8K each is a window of 500k pixels).
+    with ThreadPoolExecutor(max_workers=1) as pool:
+        pending = pool.submit(trace_panorama, geo.triangles[~on], ws, hs, window=window)
+        obj = trace_panorama(geo.triangles[on], ws, hs, window=window)
+        others = pending.result()
     proxy = (obj.tri >= 0) & ((others.tri < 0) | (obj.distance < others.distance))
     image = _window_image(hdri, frame, shape, factor)
     seg = None
