@@ -118,22 +118,27 @@ def full_resolution(solution: Solution, hdri: np.ndarray, rep: Report, callbacks
     hidden_mask[rows, cols] = window.hidden
     surfaces = _window_surfaces(solution, window, window_e, e_ref)
     radiance = np.maximum(hdri[rows, cols], 0.0)
-    difference[rows, cols] = relit_noise_stage(radiance, difference[rows, cols],
-                                               np.where(surfaces.measured, surfaces.without, -1),
-                                               enabled=solution.params.match_relit_noise, rep=rep).change
     revealed = window.hidden & (window.tri >= 0)
-    if revealed.any():
-        with rep.stage("hidden_light"):
-            found = _revealed(solution, window, window_e, radiance, surfaces, revealed)
-            light = hidden_light(solution, found, callbacks)
-        with rep.stage("synthesis"):
-            change = fill_hidden(solution, found, light, rep, callbacks)
-            difference[rows[revealed], cols[revealed]] = change
-            filled = found.panorama.maps.surface_without.copy()  # the surfaces as the fill took them
-            filled[revealed] = solution.target.surface_key[found.tri]
-            difference[rows, cols] = seamless_block_change(radiance, difference[rows, cols], revealed, filled)
-    else:
-        rep.skip("synthesis", "nothing is behind the object to fill")
+    # The relit pixels' noise is matched on a second thread while the hidden pixels are filled:
+    # neither reads what the other writes, and the fill's pixels are written over it after.
+    with ThreadPoolExecutor(max_workers=1) as pool:
+        quiet = pool.submit(relit_noise_stage, radiance, difference[rows, cols],
+                            np.where(surfaces.measured, surfaces.without, -1),
+                            enabled=solution.params.match_relit_noise, rep=rep)
+        if revealed.any():
+            with rep.stage("hidden_light"):
+                found = _revealed(solution, window, window_e, radiance, surfaces, revealed)
+                light = hidden_light(solution, found, callbacks)
+            with rep.stage("synthesis"):
+                change = fill_hidden(solution, found, light, rep, callbacks)
+                difference[rows, cols] = quiet.result().change
+                difference[rows[revealed], cols[revealed]] = change
+                filled = found.panorama.maps.surface_without.copy()  # the surfaces as the fill took them
+                filled[revealed] = solution.target.surface_key[found.tri]
+                difference[rows, cols] = seamless_block_change(radiance, difference[rows, cols], revealed, filled)
+        else:
+            difference[rows, cols] = quiet.result().change
+            rep.skip("synthesis", "nothing is behind the object to fill")
     unseen = int(window.hidden.sum() - revealed.sum())
     if unseen:
         rep.warn(f"{unseen} pixels of the object see no proxy geometry behind it; they are left unchanged")
