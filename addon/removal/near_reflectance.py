@@ -15,8 +15,8 @@ object matched the floor's albedo to within 3 % right up to the hole. So each pa
 object takes the mean over its seen pixels for its seen part, and for the part the probe does
 not see (under and behind the object) the mean of its surface's pixels right around the object;
 the change of its first bounce is shot around the room again (the propagation is linear in it)
-and added to every pixel's change of light. The room's brightening rose to about 85 % of the
-truth in the hotel room, to half of it with the photographed walls.
+and added to every pixel's change of light. The room's brightening rose to about 80 % of the
+truth in the hotel room, to about 40 % with the photographed walls.
 """
 from __future__ import annotations
 
