@@ -2,7 +2,8 @@
 windows, lamps; `scenes.spec.PHOTO_SPECS`), through the engine as the command line runs it
 (balanced, exact proxies):
     .venv/bin/python benchmarks/bench_photo_groundtruth.py [--scenes a,b] [--width 512] [--samples 32]
-Prints a markdown table of `scenes.metrics.clean_removal_scores`: light error, fill structure,
+Prints a markdown table of `scenes.metrics.clean_removal_scores`: light error (beside it the
+renders' noise floor, `scenes.metrics.noise_floor`, as bench_removal gives it), fill structure,
 detail, fill mean error, total (object + shadow error left), far damage, bruise share (hidden
 pixels darker than 0.8 x the clean surface's 1st percentile), then the surfaces filled and the
 source of their exemplars where the report names it (`filled_surfaces`), and the seconds.
@@ -65,8 +66,8 @@ def main() -> None:
     from scenes.images import write_png
 
     OUT.mkdir(parents=True, exist_ok=True)
-    table = Table(["scene", "photo", "object", "light", "structure", "detail", "mean error", "total", "far damage",
-                   "bruise share", "filled (source)", "seconds"],
+    table = Table(["scene", "photo", "object", "light", "noise floor", "structure", "detail", "mean error", "total",
+                   "far damage", "bruise share", "filled (source)", "seconds"],
                   title=f"{args.width}x{args.width // 2} at {args.samples} samples, balanced, exact proxies")
     for gt in ground_truths(args):
         s = gt.spec
@@ -75,7 +76,8 @@ def main() -> None:
         f = metrics.clean_removal_scores(gt.input, edit, gt.truth, gt.mask)
         write_png(OUT / f"{s.name}.png", comparison([gt.input, gt.truth, edit], gt.mask))
         table.row(s.name, s.room.floor.photo.source, s.removed_object().kind, f"{f['light']:.3f}",
-                  f"{f['structure']:.3f}", f"{f['detail']:.2f}", f"{f['mean_error']:.3f}", f"{f['total']:.3f}",
+                  f"{metrics.noise_floor(gt.input, gt.truth, gt.mask):.3f}", f"{f['structure']:.3f}",
+                  f"{f['detail']:.2f}", f"{f['mean_error']:.3f}", f"{f['total']:.3f}",
                   f"{f['far_damage']:.3f}", f"{f['bruise_share']:.3f}", _sources(r.report),
                   f"{r.report['seconds']['total']:.1f}")
     write(table, notes=[BOUNDS])

@@ -13,7 +13,7 @@ from ..callbacks import RunCallbacks
 from ..geometry import latlong
 from ..geometry.mesh import Geometry, surfaces_of
 from ..geometry.planeraster import Frame, edge_direction
-from ..light.radiosity import LUMA, RHO_MAX
+from ..light.radiosity import RHO_MAX
 from ..report import Report
 from ..synthesis.material import Material
 from ..synthesis.plane_fill import (
@@ -27,6 +27,7 @@ from ..synthesis.plane_fill import (
 from ..synthesis.surface_edges import SurfaceEdges, SurfacePlane, find_surface_edges
 from ..synthesis.texture import SynthesisParams
 from .irradiance import light_after
+from .near_reflectance import measuring
 from .room import MIN_COS
 from .solution import Solution
 
@@ -320,9 +321,7 @@ def measured_reflectance(radiance: np.ndarray, e: np.ndarray, measured: np.ndarr
 def working_measured(solution: Solution) -> np.ndarray:
     """(N,) bool: the hit pixels that measure a reflectance (not hidden, not a light, not too
     dark against the median irradiance)."""
-    e_h = solution.e_h
-    e_ref = float(np.median(e_h @ LUMA))
-    return ~solution.traced.hidden_h & ~solution.room.pixels.emitter_h & ((e_h @ LUMA) > 1e-3 * e_ref)
+    return measuring(solution.traced, solution.room.pixels.emitter_h, solution.e_h)
 
 
 def _panorama_reflectance(solution: Solution, radiance: np.ndarray, edges: SurfaceEdges) -> PanoramaReflectance:

@@ -32,6 +32,7 @@ class FirstOrder:
     room: Room
     de: np.ndarray
     split: Split
+    refined: np.ndarray  # (n,) the patches near the object, sampled within
 
 
 @dataclass
@@ -70,7 +71,7 @@ def first_order(room: Room, target: Target, occlusion: Occlusion, params: Params
     rep.info["refined_patches"] = len(refine)
     if not len(refine):
         de = room.patch_mean((room.t_without - room.t_with) @ b)
-        return FirstOrder(room, de, _split(room, de, [], params))
+        return FirstOrder(room, de, _split(room, de, [], params), refine)
     k = params.patch_samples
     sampled = _sample(room, refine, k, occlusion, callbacks)
     # The samples are this function's own: their transport is completed in place below.
@@ -102,7 +103,7 @@ def first_order(room: Room, target: Target, occlusion: Occlusion, params: Params
     de = room.patch_mean((room.t_without - room.t_with) @ b)
     for idx, _, _, de_g in groups:
         de[idx] = de_g.mean(axis=1)
-    return FirstOrder(room, de, _split(room, de, groups, params))
+    return FirstOrder(room, de, _split(room, de, groups, params), refine)
 
 
 def _sample(room: Room, idx: np.ndarray, k: int, occlusion: Occlusion, callbacks: RunCallbacks) -> _Samples:

@@ -13,6 +13,7 @@ from ..quality import Params
 from ..report import Report
 from .first_order import FirstOrder
 from .occlusion import Occlusion
+from .room import Room
 
 
 @dataclass(frozen=True)
@@ -29,12 +30,28 @@ def propagate_change(first: FirstOrder, occlusion: Occlusion, params: Params, re
     """Shoot the first change around the room until a bounce adds less than `bounce_tolerance`
     (or `max_bounces`); a split patch leaves its first change to its sub-triangles."""
     room, split = first.room, first.split
-    p, m = len(room.areas), len(split.parent)
-    db1 = room.rho * first.de
-    db1[room.senders.on_removed | room.emitter] = 0.0
-    db1[split.parent] = 0.0
     split = split.with_transport(*occlusion.transport(room.receivers.points, room.receivers.normals, split.senders,
                                                       callbacks))
+    total, bounces = shoot(room, split, first_change(room, first.de, split), split.db, params)
+    rep.info["bounces"] = bounces
+    rep.info["split_patches"] = len(np.unique(split.parent))
+    return Propagation(total, split)
+
+
+def first_change(room: Room, de: np.ndarray, split: Split) -> np.ndarray:
+    """(P, 3) the first change of the patches' radiosity, rho dE: none for the object's patches
+    and the lights, and none for a split patch (its sub-triangles carry its first change)."""
+    db1 = room.rho * de
+    db1[room.senders.on_removed | room.emitter] = 0.0
+    db1[split.parent] = 0.0
+    return db1
+
+
+def shoot(room: Room, split: Split, db1: np.ndarray, sub_db1: np.ndarray, params: Params) -> tuple[np.ndarray, int]:
+    """(P, 3) the change of the patches' radiosity over every bounce of a first change db1 (P, 3)
+    of the patches and sub_db1 (M, 3) of the split's sub-triangles (whose transport the split
+    holds), and the bounces it took. Linear in the first change."""
+    p, m = len(room.areas), len(split.parent)
 
     # The sub-triangles send the first bounce only (reflectance 0): their light is gathered
     # by the patches, which carry every later bounce.
@@ -43,10 +60,8 @@ def propagate_change(first: FirstOrder, occlusion: Occlusion, params: Params, re
         return np.concatenate([e, np.zeros((m, 3))])
 
     total, bounces = propagate(
-        np.concatenate([db1, split.db]), np.concatenate([room.rho, np.zeros((m, 3))]),
+        np.concatenate([db1, sub_db1]), np.concatenate([room.rho, np.zeros((m, 3))]),
         np.concatenate([room.areas, split.areas]), gather, tolerance=params.bounce_tolerance,
         max_bounces=params.max_bounces,
     )
-    rep.info["bounces"] = bounces
-    rep.info["split_patches"] = len(np.unique(split.parent))
-    return Propagation(total[:p], split)
+    return total[:p], bounces

@@ -193,6 +193,16 @@ def _pixel_lookup(traced: Traced, patches: Patches, receivers: Receivers
     return patch_h, receivers.vertex_row[corners_h], weights_h
 
 
+def pixel_areas(traced: Traced) -> tuple[np.ndarray, int]:
+    """(N,) the surface area each hit pixel covers (so that means over a patch's pixels are over
+    its area, not its pixels), and how many are seen so grazing that their weight is capped."""
+    width, height, hp = traced.width, traced.height, traced.hp
+    cos = np.abs(np.einsum("ij,ij->i", traced.hits.directions.reshape(-1, 3)[hp], traced.normals_h))
+    solid = np.broadcast_to(latlong.pixel_solid_angles(width, height), (height, width)).ravel()[hp]
+    dist = traced.hits.distance.ravel()[hp]
+    return solid * dist**2 / np.maximum(cos, MIN_COS), int((cos < MIN_COS).sum())
+
+
 def _measured(hdri: np.ndarray, traced: Traced, patch_h: np.ndarray, areas: np.ndarray, rep: Report
               ) -> tuple[np.ndarray, np.ndarray]:
     """(P, 3) radiosity of the patches as the panorama shows them (the area-weighted mean of
@@ -200,14 +210,9 @@ def _measured(hdri: np.ndarray, traced: Traced, patch_h: np.ndarray, areas: np.n
     photograph shows the object in though the proxy misses it would lend the surface behind it
     the object's colour, and one of the proxy the photograph shows no object in the object
     the surface's: neither counts."""
-    width, height, hp = traced.width, traced.height, traced.hp
-    cos = np.abs(np.einsum("ij,ij->i", traced.hits.directions.reshape(-1, 3)[hp], traced.normals_h))
-    guarded = int((cos < MIN_COS).sum())
+    weight, guarded = pixel_areas(traced)
     if guarded:
         rep.guard("grazing_pixels_weight_capped", guarded)
-    solid = np.broadcast_to(latlong.pixel_solid_angles(width, height), (height, width)).ravel()[hp]
-    dist = traced.hits.distance.ravel()[hp]
-    weight = solid * dist**2 / np.maximum(cos, MIN_COS)
     weight[traced.beyond_h | traced.kept_h] = 0.0
     b, cover = patch_radiosity(traced.panorama_rows(hdri), patch_h, weight, areas)
     return b, cover >= _VISIBLE

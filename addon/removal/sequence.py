@@ -28,6 +28,7 @@ from .first_order import first_order
 from .full_resolution import full_resolution
 from .lit_room import LitRoom
 from .local import local_light
+from .near_reflectance import corrected_near_object
 from .occlusion import occluders
 from .propagation import propagate_change
 from .relit_noise import relit_noise_stage
@@ -109,6 +110,7 @@ def solve_lighting(hdri: np.ndarray, geo: Geometry, target: Target, traced: Trac
                   split=propagation.split)
     with rep.stage("local"):
         local = local_light(lit, traced, params, rep, callbacks)
+        lit, local = corrected_near_object(lit, first, traced, traced.panorama_rows(hdri), local, params, rep)
     return Solution(hdri=hdri, params=params, lit=lit, traced=traced, e_h=local.e_h, de_h=local.de_h, seen=seen)
 
 

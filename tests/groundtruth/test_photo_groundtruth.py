@@ -29,19 +29,24 @@ BOUNDS = {
     "far_damage": (None, 0.05),
 }
 # (scene, figure): what the engine measured where it fails the bound (256x128). Of each total,
-# the error left outside the object (the relit shadow and light, region A) alone is 0.251
-# (hotel_box), 0.152 (hotel_walls) and 0.145 (workshop_box): no fill meets 0.2 there by itself.
+# the error left outside the object (the relit shadow and light, region A) alone is 0.241
+# (hotel_box), 0.136 (hotel_walls) and 0.154 (workshop_box): no fill meets 0.2 there by itself.
+# At 32 samples region A is mostly render noise: the truth's own change smoothed over 5x5 px
+# leaves 0.22 of hotel_box's light error, over 9x9 px 0.33 (the engine 0.35).
 FAILING: dict[tuple[str, str], str] = {
     # The wood between the rug and the desk chair, printed brighter where the box stands (0.57)
-    # than the wood around it (0.41 within 4 px), is filled a fifth too dark.
-    ("hotel_box", "total"): "measured 0.459",
-    ("hotel_box", "mean_error"): "measured 0.182",
+    # than the wood around it, is filled a fifth too dark: the brightest wood at the hole's
+    # border is found in too few directions around it to count as its material (about half of
+    # them, three quarters needed) and is left out of the exemplar, the darker wood and the
+    # rug's stripes farther out are kept (the exemplar's mean 0.40, the border's 0.50).
+    ("hotel_box", "total"): "measured 0.448",
+    ("hotel_box", "mean_error"): "measured 0.181",
     # The desk chair's dark foot copied into the floor behind the armchair-sized box, and the
     # wall's fill (too little of its material seen to synthesise) at the mean of the door frame.
-    ("hotel_walls", "total"): "measured 0.748",
-    ("hotel_walls", "mean_error"): "measured 0.355",
+    ("hotel_walls", "total"): "measured 0.722",
+    ("hotel_walls", "mean_error"): "measured 0.347",
     # The yellow floor line is continued into the hole with a branch the truth does not have.
-    ("workshop_box", "total"): "measured 0.358",
+    ("workshop_box", "total"): "measured 0.367",
 }
 
 
