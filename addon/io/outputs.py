@@ -12,7 +12,6 @@ import os
 import shutil
 import tempfile
 from collections.abc import Callable, Sequence
-from concurrent.futures import ThreadPoolExecutor
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -20,6 +19,7 @@ import numpy as np
 from ..errors import DimredError
 from ..radiance import all_finite, non_finite_pixels, round_to_stored_precision
 from ..segmentation.diagnostics import picture_of
+from ..side_by_side import both
 from . import exr
 
 if TYPE_CHECKING:
@@ -38,11 +38,9 @@ def write_outputs(out: str, result: RemovalResult, report: dict) -> None:
             raise DimredError("the removal produced non-finite values in difference.exr; nothing was written")
         # The whole-image writer lets go of the interpreter lock while it compresses, so the
         # difference is written on a second core beside the edited panorama's bands.
-        with ThreadPoolExecutor(max_workers=1) as pool:
-            difference = pool.submit(exr.write_exr, os.path.join(staging, "difference.exr"), result.difference)
-            edited = _finite("edited.exr", _edited_as_stored(result))
-            exr.write_exr_rows(os.path.join(staging, "edited.exr"), height, width, edited)
-            difference.result()
+        edited = _finite("edited.exr", _edited_as_stored(result))
+        both(lambda: exr.write_exr_rows(os.path.join(staging, "edited.exr"), height, width, edited),
+             lambda: exr.write_exr(os.path.join(staging, "difference.exr"), result.difference))
 
     writers: dict[str, Callable[[str], None]] = {"": images, "report.json": json_writer(report)}
     if mask is not None:

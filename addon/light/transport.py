@@ -13,13 +13,13 @@ is taken away.
 from __future__ import annotations
 
 from collections.abc import Callable
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, replace
 from functools import cached_property
 
 import numpy as np
 
 from ..geometry.occluders import Occluders
+from ..side_by_side import both
 from . import aggregate
 from .formfactor import point_to_triangle
 
@@ -120,12 +120,10 @@ def form_factors(points: np.ndarray, normals: np.ndarray, senders: Senders) -> n
     f = np.zeros((len(points), len(senders)))
     # The clusters' aggregates (and on the first call their hierarchy: half a second for a mesh
     # of 200k triangles) on a second thread beside the single senders' exact form factors.
-    with ThreadPoolExecutor(max_workers=1) as pool:
-        aggregated = pool.submit(lambda: aggregate.form_factors(np.asarray(points, dtype=np.float64),
-                                                                np.asarray(normals, dtype=np.float64),
-                                                                parts.hierarchy))
-        f[:, single] = point_to_triangle(points, normals, senders.triangles[single], senders.normals[single])
-        f[:, parts.clustered] = aggregated.result()
+    f[:, single], f[:, parts.clustered] = both(
+        lambda: point_to_triangle(points, normals, senders.triangles[single], senders.normals[single]),
+        lambda: aggregate.form_factors(np.asarray(points, dtype=np.float64), np.asarray(normals, dtype=np.float64),
+                                       parts.hierarchy))
     return f
 
 

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -15,6 +14,7 @@ from ..geometry.mesh import Geometry, surfaces_of
 from ..geometry.planeraster import Frame, edge_direction
 from ..light.radiosity import RHO_MAX
 from ..report import Report
+from ..side_by_side import each
 from ..synthesis.material import Material
 from ..synthesis.plane_fill import (
     FillOptions,
@@ -30,8 +30,6 @@ from .irradiance import light_after
 from .near_reflectance import measuring
 from .room import MIN_COS
 from .solution import Solution
-
-_FILL_THREADS = 2  # planes filled at once: each holds its raster's synthesis pyramid
 
 
 @dataclass(frozen=True)
@@ -120,11 +118,7 @@ def fill_hidden(solution: Solution, revealed: Revealed, light: HiddenLight, rep:
     # Without a preview to show level by level, the planes (the floor and the walls behind a
     # large object) are filled side by side: each is numpy on arrays of its own, and they are
     # taken in order afterwards. The hotel photograph's three took 1.65 s, now 1.13 s.
-    if show is None and len(planes) > 1:
-        with ThreadPoolExecutor(max_workers=_FILL_THREADS) as pool:
-            fills = list(pool.map(fill, planes))
-    else:
-        fills = map(fill, planes)  # one after the other, each shown as it comes
+    fills = each(fill, planes) if show is None else map(fill, planes)  # with a preview, each shown as it comes
     surfaces = []
     for (sel, _), (got, seconds) in zip(planes, fills, strict=True):
         name = geo.object_names[geo.tri_object[revealed.tri[sel[0]]]]

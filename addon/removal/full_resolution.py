@@ -10,7 +10,6 @@ and the difference written in bands of rows, into one float32 image.
 """
 from __future__ import annotations
 
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, replace
 from functools import cached_property
 
@@ -23,6 +22,7 @@ from ..geometry.planeraster import PlaneRaster, build_raster
 from ..light.radiosity import LUMA
 from ..radiance import clamped_rows
 from ..report import Report
+from ..side_by_side import both, each
 from ..synthesis.plane_fill import PanoramaMaps, PanoramaReflectance
 from ..synthesis.surface_edges import SurfaceEdges
 from .compose import ratio_change, reference_irradiance
@@ -46,7 +46,6 @@ from .solution import Solution
 from .working_maps import Cells, WorkingMaps, cells, neighbours, surfaces_seen, working_maps
 
 _BAND_PIXELS = 1 << 19  # full-resolution pixels per band (arrays of a few MB: reused, not mapped anew)
-_BAND_THREADS = 2  # bands upsampled at once
 _SHARP = 0.1  # neighbours whose dE / E differ by more than this leave the pixel to be refined
 
 
@@ -119,26 +118,32 @@ def full_resolution(solution: Solution, hdri: np.ndarray, rep: Report, callbacks
     surfaces = _window_surfaces(solution, window, window_e, e_ref)
     radiance = np.maximum(hdri[rows, cols], 0.0)
     revealed = window.hidden & (window.tri >= 0)
+
+    def fill() -> tuple[Revealed, np.ndarray] | None:
+        """The revealed pixels and their change, None where there are none."""
+        if not revealed.any():
+            return None
+        with rep.stage("hidden_light"):
+            found = _revealed(solution, window, window_e, radiance, surfaces, revealed)
+            light = hidden_light(solution, found, callbacks)
+        with rep.stage("synthesis"):
+            return found, fill_hidden(solution, found, light, rep, callbacks)
+
     # The relit pixels' noise is matched on a second thread while the hidden pixels are filled:
     # neither reads what the other writes, and the fill's pixels are written over it after.
-    with ThreadPoolExecutor(max_workers=1) as pool:
-        quiet = pool.submit(relit_noise_stage, radiance, difference[rows, cols],
-                            np.where(surfaces.measured, surfaces.without, -1),
-                            enabled=solution.params.match_relit_noise, rep=rep)
-        if revealed.any():
-            with rep.stage("hidden_light"):
-                found = _revealed(solution, window, window_e, radiance, surfaces, revealed)
-                light = hidden_light(solution, found, callbacks)
-            with rep.stage("synthesis"):
-                change = fill_hidden(solution, found, light, rep, callbacks)
-                difference[rows, cols] = quiet.result().change
-                difference[rows[revealed], cols[revealed]] = change
-                filled = found.panorama.maps.surface_without.copy()  # the surfaces as the fill took them
-                filled[revealed] = solution.target.surface_key[found.tri]
-                difference[rows, cols] = seamless_block_change(radiance, difference[rows, cols], revealed, filled)
-        else:
-            difference[rows, cols] = quiet.result().change
-            rep.skip("synthesis", "nothing is behind the object to fill")
+    filled, quiet = both(fill, lambda: relit_noise_stage(radiance, difference[rows, cols],
+                                                         np.where(surfaces.measured, surfaces.without, -1),
+                                                         enabled=solution.params.match_relit_noise, rep=rep))
+    difference[rows, cols] = quiet.change
+    if filled is None:
+        rep.skip("synthesis", "nothing is behind the object to fill")
+    else:
+        found, change = filled
+        with rep.stage("synthesis"):
+            difference[rows[revealed], cols[revealed]] = change
+            surface = found.panorama.maps.surface_without.copy()  # the surfaces as the fill took them
+            surface[revealed] = solution.target.surface_key[found.tri]
+            difference[rows, cols] = seamless_block_change(radiance, difference[rows, cols], revealed, surface)
     unseen = int(window.hidden.sum() - revealed.sum())
     if unseen:
         rep.warn(f"{unseen} pixels of the object see no proxy geometry behind it; they are left unchanged")
@@ -248,10 +253,8 @@ def _upsample(solution: Solution, maps: WorkingMaps, canvas: _Canvas, rep: Repor
         return _Refine(rows[0] * width + idx, pixels.tri[idx], pixels.bary[idx], pixels.distance[idx],
                        spread[idx], pixels.ring[idx])
 
-    # Two bands at a time: each writes rows of its own, numpy lets go of the interpreter lock
-    # for a band's arithmetic, and the pixels to refine are taken in the bands' order.
-    with ThreadPoolExecutor(max_workers=_BAND_THREADS) as pool:
-        parts = list(pool.map(band_of, range(0, height, band)))
+    # Bands side by side, each writing rows of its own; the pixels to refine in the bands' order.
+    parts = each(band_of, range(0, height, band))
     return _Refine(*(np.concatenate([getattr(p, f) for p in parts]) for f in _Refine.__dataclass_fields__))
 
 

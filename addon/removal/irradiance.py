@@ -2,7 +2,6 @@
 fine lattice laid over the triangles where points need it."""
 from __future__ import annotations
 
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -10,6 +9,7 @@ import numpy as np
 from ..callbacks import RunCallbacks
 from ..geometry.patches import build_lattice, levels_for_size
 from ..light.split import Split
+from ..side_by_side import both
 from .interpolation import inset, interpolate
 from .lit_room import LitRoom
 from .room import Room
@@ -65,8 +65,9 @@ def light_after(lit: LitRoom, tri: np.ndarray, bary: np.ndarray, callbacks: RunC
     lattice = _fine_lattice(lit, tri, bary)
     callbacks.check()
     occlusion, room, split = lit.occlusion, lit.room, lit.split
-    t_without = occlusion.transport_without(lattice.vertices, lattice.normals, room.senders, callbacks)
-    ts_without = occlusion.transport_without(lattice.vertices, lattice.normals, split.senders, callbacks)
+    t_without, ts_without = both(
+        lambda: occlusion.transport_without(lattice.vertices, lattice.normals, room.senders, callbacks),
+        lambda: occlusion.transport_without(lattice.vertices, lattice.normals, split.senders, callbacks))
     return interpolate(_after(room, lit.db, split, t_without, ts_without), lattice.corners, lattice.weights)
 
 
@@ -114,10 +115,9 @@ def point_light(points: np.ndarray, normals: np.ndarray, lit: LitRoom, callbacks
 
 def _light_of(points: np.ndarray, normals: np.ndarray, lit: LitRoom, corners: np.ndarray, weights: np.ndarray,
               callbacks: RunCallbacks) -> FineLight:
-    # The split patches' transport beside the patches' on a second thread: beside a large
-    # object (the hotel's armchair) it is a quarter of the lattice's time.
-    with ThreadPoolExecutor(max_workers=1) as pool:
-        split = pool.submit(lit.occlusion.transport, points, normals, lit.split.senders, callbacks)
-        t_with, t_without = lit.occlusion.transport(points, normals, lit.room.senders, callbacks)
-        e, e_after = before_and_after(lit.room, lit.db, lit.split, t_with, t_without, *split.result())
+    # The split patches' transport beside the patches': beside a large object (the hotel's
+    # armchair) it is a quarter of the lattice's time.
+    (t_with, t_without), split = both(lambda: lit.occlusion.transport(points, normals, lit.room.senders, callbacks),
+                                      lambda: lit.occlusion.transport(points, normals, lit.split.senders, callbacks))
+    e, e_after = before_and_after(lit.room, lit.db, lit.split, t_with, t_without, *split)
     return FineLight(t_with, t_without, e, e_after, corners, weights)

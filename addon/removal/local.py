@@ -3,7 +3,6 @@ the coarse lattice, from a fine lattice near the object, and per pixel where the
 shadows an important sender."""
 from __future__ import annotations
 
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -15,9 +14,10 @@ from ..light.radiosity import LUMA
 from ..light.transport import pair_visibility
 from ..quality import Params
 from ..report import Report
+from ..side_by_side import both
 from .emitter_groups import GROUP_SAMPLES, emitter_groups, sample_counts
 from .interpolation import interpolate
-from .irradiance import before_and_after, fine_light, point_light
+from .irradiance import FineLight, before_and_after, fine_light, point_light
 from .lit_room import LitRoom
 from .room import Room
 from .shadow_cells import PairShadow, PixelGrid, cell_shadows
@@ -121,15 +121,16 @@ def light_at(lit: LitRoom, receiving: Receiving, params: Params, callbacks: RunC
     # the pixels near them unevenly, which coarse vertices would smear over a coarse patch.
     # It is computed on a second thread while the significant pairs are found.
     near_pixels = candidate[near]
-    with ThreadPoolExecutor(max_workers=1) as pool:
-        pending = None
-        if len(near_pixels) and per_point:
-            pending = pool.submit(point_light, receiving.points[near_pixels], receiving.normals[near_pixels], lit,
-                                  callbacks)
-        elif len(near_pixels):
-            pending = pool.submit(fine_light, lit, receiving.tri[near_pixels], receiving.bary[near_pixels], callbacks)
-        sig = significant(room.senders, imp, receiving.points[candidate], e_h[candidate], target, params)
-        fine = None if pending is None else pending.result()
+
+    def base() -> FineLight | None:
+        if not len(near_pixels):
+            return None
+        if per_point:
+            return point_light(receiving.points[near_pixels], receiving.normals[near_pixels], lit, callbacks)
+        return fine_light(lit, receiving.tri[near_pixels], receiving.bary[near_pixels], callbacks)
+
+    sig, fine = both(lambda: significant(room.senders, imp, receiving.points[candidate], e_h[candidate], target,
+                                         params), base)
     affected = int((sig.any(axis=1) | near).sum())
     if not (sig.any() or near.any()):
         return PointLight(e_h, de_h, affected, 0, 0)
@@ -185,11 +186,9 @@ def _on_two_threads(shadow: PairShadow) -> PairShadow:
         first = pix <= np.median(pix) if len(pix) >= _THREADED_PAIRS else np.ones(len(pix), dtype=bool)
         if first.all():
             return shadow(pix, s)
-        with ThreadPoolExecutor(max_workers=1) as pool:
-            pending = pool.submit(shadow, pix[~first], s[~first])
-            e, de = np.empty((len(pix), 3)), np.empty((len(pix), 3))
-            e[first], de[first] = shadow(pix[first], s[first])
-            e[~first], de[~first] = pending.result()
+        e, de = np.empty((len(pix), 3)), np.empty((len(pix), 3))
+        (e[first], de[first]), (e[~first], de[~first]) = both(lambda: shadow(pix[first], s[first]),
+                                                              lambda: shadow(pix[~first], s[~first]))
         return e, de
 
     return split

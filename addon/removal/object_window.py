@@ -2,7 +2,6 @@
 what they reveal once it is gone, and the surfaces the fill's exemplar is read from."""
 from __future__ import annotations
 
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -13,6 +12,7 @@ from ..geometry.planeraster import Frame
 from ..geometry.raycast import trace_panorama
 from ..geometry.span import pixel_span
 from ..segmentation.seen import SeenObject
+from ..side_by_side import each
 from .target import Target
 from .working_maps import WorkingMaps, neighbours, surfaces_seen
 
@@ -20,7 +20,6 @@ _PAD = 4  # working pixels the window reaches past what it must hold
 _MAX_PIXELS = 2 << 20  # the largest window (its arrays and the fill's maps take ~120 bytes a pixel)
 _RING = 3  # full-resolution pixels beside the object always get their own light
 _BLOCK_PIXELS = 1 << 19  # pixels looked up at a time (bounds the candidates' temporaries)
-_BLOCK_THREADS = 2  # blocks looked up at once
 
 
 @dataclass(frozen=True)
@@ -96,9 +95,7 @@ def object_window(geo: Geometry, target: Target, hidden_working: np.ndarray, cov
         distance[start:start + len(rows_b)] = found.distance.reshape(-1, ncols)
         bary[start:start + len(rows_b)] = found.bary.reshape(-1, ncols, 2)
 
-    # Two blocks at a time, each writing rows of its own (an 8K window is millions of pixels).
-    with ThreadPoolExecutor(max_workers=_BLOCK_THREADS) as pool:
-        list(pool.map(look_up, range(0, shape[0], block)))
+    each(look_up, range(0, shape[0], block))  # blocks side by side, each writing rows of its own
     on_object = object_distance < distance
     frame = Frame(row_start, col_start, height, width)
     hidden = latlong.dilate(on_object if seen is None else seen.in_frame(frame, shape), 1)

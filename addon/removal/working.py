@@ -2,15 +2,13 @@
 change of light is smooth except where the full-resolution stage refines it."""
 from __future__ import annotations
 
-from concurrent.futures import ThreadPoolExecutor
-
 import numpy as np
 
 from ..geometry.resample import interpolate, resample_axis
 from ..radiance import clamped_rows
+from ..side_by_side import each
 
 _BAND_BYTES = 64 << 20  # rows of the full panorama averaged at a time (float64)
-_BAND_THREADS = 2  # bands averaged at once
 
 
 def working_size(width: int, height: int, *, max_width: int) -> tuple[int, int]:
@@ -39,9 +37,7 @@ def downsample(radiance: np.ndarray, width: int, height: int) -> np.ndarray:
     def average(start: int) -> None:
         out[start // step:(start + band) // step] = _block_means(clamped_rows(radiance, start, start + band), step)
 
-    # Two bands at a time, each writing output rows of its own.
-    with ThreadPoolExecutor(max_workers=_BAND_THREADS) as pool:
-        list(pool.map(average, range(0, rows_in, band)))
+    each(average, range(0, rows_in, band))  # bands side by side, each writing output rows of its own
     return out
 
 

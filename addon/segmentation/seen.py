@@ -8,7 +8,6 @@ an area-averaged copy when it would exceed `_MAX_PIXELS` (a close object in a 16
 """
 from __future__ import annotations
 
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -21,6 +20,7 @@ from ..geometry.raycast import trace_panorama
 from ..geometry.span import pixel_span
 from ..light.radiosity import LUMA
 from ..report import Report
+from ..side_by_side import both
 from .grabcut import ObjectSegmentation, segment_object
 from .masks import blur, box_mean, dilate
 from .user_mask import UserMask
@@ -123,10 +123,8 @@ def seen_object(hdri: np.ndarray, geo: Geometry, index: int, *, segment: bool = 
     frame, shape = _window(spot, band_px + _PAD, hs, ws)
     window = (frame.row0, shape[0], frame.col0, shape[1])
     # The object and the rest are traced side by side (at 8K each is a window of 500k pixels).
-    with ThreadPoolExecutor(max_workers=1) as pool:
-        pending = pool.submit(trace_panorama, geo.triangles[~on], ws, hs, window=window)
-        obj = trace_panorama(geo.triangles[on], ws, hs, window=window)
-        others = pending.result()
+    obj, others = both(lambda: trace_panorama(geo.triangles[on], ws, hs, window=window),
+                       lambda: trace_panorama(geo.triangles[~on], ws, hs, window=window))
     proxy = (obj.tri >= 0) & ((others.tri < 0) | (obj.distance < others.distance))
     image = _window_image(hdri, frame, shape, factor)
     seg = None
