@@ -646,8 +646,8 @@ def _rank_offsets(image: np.ndarray, ring: np.ndarray, hole: np.ndarray, ex: np.
     as under the best-covering shift; picked shifts suppress their 3 x 3 neighbours."""
     (h, w), (eh, ew) = ring.shape, ex_valid.shape
     size = correlation_size((h, w), (eh, ew))
-    img, exv = np.where(ring[..., None], image, 0).astype(np.float64), np.where(ex_valid[..., None], ex, 0)
-    exv = exv.astype(np.float64)
+    img = np.where(ring[..., None], image, 0).astype(np.float64)
+    exv = np.where(ex_valid[..., None], ex, 0).astype(np.float64)
     f_ring, f_valid = spectrum(ring.astype(np.float64), size), spectrum(ex_valid.astype(np.float64), size)
     # the ring's sum of image^2 + ex^2 - 2 image.ex under each shift, transformed back once
     num = correlation(cross_spectrum(spectrum((img ** 2).sum(axis=2), size), f_valid)
