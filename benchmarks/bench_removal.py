@@ -44,15 +44,17 @@ def main() -> None:
         r = remove_object(scene, spec.remove, quality=preset)
         ratio = metrics.lighting_error_ratio(inp, r.edited, truth, mask)
         rows.append((preset, r.report["seconds"], ratio, metrics.hidden_region_scores(inp, r.edited, truth, mask)))
-    stages = [k for k in rows[0][1] if k != "total"]
+    # Presets run different stages (a narrower working copy is downsampled and refined).
+    stages = list(dict.fromkeys(k for _, sec, _, _ in rows for k in sec if k != "total"))
     table = Table(["preset", *stages, "total s", "error ratio", "hidden mean", "hidden detail", "object + shadow"],
                   title=f"scene {args.scene} {args.width}x{args.width // 2} @ {args.samples} spp; "
                         f"read_scene {read_s:.2f} s; noise floor {floor:.3f}")
     for preset, sec, ratio, hidden in rows:
-        table.row(preset, *(f"{sec[k]:.2f}" for k in stages), f"{sec['total']:.2f}", f"{ratio:.3f}",
+        table.row(preset, *(f"{sec[k]:.2f}" if k in sec else "-" for k in stages), f"{sec['total']:.2f}", f"{ratio:.3f}",
                   f"{hidden['mean_ratio']:.3f}", f"{hidden['detail_ratio']:.2f}",
                   f"{hidden['object_shadow_ratio']:.3f}")
     write(table)
+
 
 if __name__ == "__main__":
     main()
