@@ -7,10 +7,12 @@ keep every distance and angle, so form factors and visibility are unchanged.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
 from ..errors import DimredError
+from .raycast import Projection, project
 
 
 @dataclass
@@ -25,6 +27,11 @@ class Geometry:
     scale: float  # size of the scene (bounding-box diagonal), for tolerances
     dropped_degenerate: int
     source: np.ndarray  # (T,) row of each triangle in the scene's triangle list
+
+    @cached_property
+    def projection(self) -> Projection:
+        """The triangles as the probe sees them (`raycast.project`), for every trace of them."""
+        return project(self.triangles)
 
     def object_bounds(self, index: int) -> tuple[np.ndarray, np.ndarray]:
         tris = self.triangles[self.tri_object == index].reshape(-1, 3)
@@ -174,7 +181,15 @@ def surface_keys(geometry: Geometry, *, angle_tolerance: float = 1e-3) -> np.nda
         ],
         axis=1,
     )
-    return np.unique(key, axis=0, return_inverse=True)[1].ravel()
+    # np.unique's ids (rows in lexicographic order), by a sort per column: np.unique(axis=0)
+    # compares whole rows and took 0.4 s for 200k triangles, this 0.05 s.
+    order = np.lexsort(key.T[::-1])
+    ordered = key[order]
+    first = np.ones(len(key), dtype=bool)
+    first[1:] = (ordered[1:] != ordered[:-1]).any(axis=1)
+    ids = np.empty(len(key), dtype=np.int64)
+    ids[order] = np.cumsum(first) - 1
+    return ids
 
 
 def surfaces_of(keys: np.ndarray, tri: np.ndarray) -> np.ndarray:

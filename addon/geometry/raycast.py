@@ -7,7 +7,7 @@ a few rays against every triangle. Which segments are blocked is `occluders.Occl
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 
@@ -33,36 +33,76 @@ class PanoramaHits:
         return self.directions * self.distance[..., None]
 
 
-def _uv_window(tris: np.ndarray, edge_normals: np.ndarray, width: int, height: int) -> tuple[np.ndarray, ...]:
-    """Pixel windows (row0, rows, col0, cols) holding the centres of every pixel that
-    triangles seen from the origin (with their `_edge_normals`) may cover; rows or cols 0
-    where they cover none.
+@dataclass(frozen=True)
+class Projection:
+    """Triangles as the origin sees them, whatever the panorama's size: what `trace_panorama`
+    needs of each triangle before it rasterises it. A mesh is traced several times (its
+    coarse spot, its segmentation window, the working copy, the full-resolution window):
+    with 200k triangles, working this out took half of each trace. Rows and columns are
+    shares of the panorama's height and width."""
 
-    The bounds are exact, widened by `_MARGIN` pixel: an edge seen from the origin is an arc of a
-    great circle, shorter than half of it, along which the elevation has at most one extreme
-    (`_edge_extreme_rows`) and the longitude runs one way, over less than half the circle.
-    So a triangle that holds no pole spans the longitudes between its corners, the circle
-    less the largest gap between them, and a few corners cost what a sliver of a pixel does."""
+    seen: np.ndarray  # (T,) bool: not edge-on (an edge-on triangle covers no pixel centre)
+    edge_normals: np.ndarray  # (T, 3, 3) `_edge_normals`, zero where not seen
+    normal: np.ndarray  # (T, 3) unnormalised normals ...
+    offset: np.ndarray  # (T,) ... and their dot products with the first corner
+    top: np.ndarray  # (T,) the least and greatest row share of any point of the triangle
+    bottom: np.ndarray
+    start: np.ndarray  # (T,) the column share where its run of longitudes starts ...
+    span: np.ndarray  # ... and the run's length: the circle less the widest gap between corners
+    north: np.ndarray  # (T,) bool: it holds the north pole, so every column near it
+    south: np.ndarray
+
+    def take(self, index: np.ndarray) -> Projection:
+        """The projection of the triangles `index` (indices or a mask) picks, in that order."""
+        return Projection(*(getattr(self, f.name)[index] for f in fields(self)))
+
+
+def project(triangles: np.ndarray) -> Projection:
+    """The `Projection` of triangles (T, 3, 3) seen from the origin.
+
+    The bounds are exact: an edge seen from the origin is an arc of a great circle, shorter
+    than half of it, along which the elevation has at most one extreme (`_edge_extreme_rows`)
+    and the longitude runs one way, over less than half the circle. So a triangle that holds
+    no pole spans the longitudes between its corners, the circle less the largest gap between
+    them, and a few corners cost what a sliver of a pixel does."""
+    n = len(triangles)
+    det = np.einsum("ij,ij->i", triangles[:, 0], np.cross(triangles[:, 1], triangles[:, 2]))
+    scale = np.linalg.norm(triangles, axis=2).max(axis=1) ** 3
+    seen = np.abs(det) > 1e-12 * scale
+    tris = triangles[seen]
+    edge_normals = np.zeros((n, 3, 3))
+    edge_normals[seen] = _edge_normals(tris)
     corners = np.arccos(np.clip(tris[..., 2] / np.maximum(np.linalg.norm(tris, axis=2), 1e-300), -1.0, 1.0))
-    rows = np.concatenate([corners / np.pi * height, _edge_extreme_rows(tris, height)], axis=1)
-    # Pixel r's centre lies at r + 0.5 rows (columns) from the top (the seam).
-    row0 = np.maximum(np.ceil(rows.min(axis=1) - 0.5 - _MARGIN), 0).astype(np.int64)
-    row1 = np.minimum(np.floor(rows.max(axis=1) - 0.5 + _MARGIN), height - 1).astype(np.int64)
+    rows = np.concatenate([corners / np.pi, _edge_extreme_rows(tris)], axis=1)
     u = np.sort(latlong.direction_to_uv(tris)[0], axis=1)
     gaps = np.diff(np.concatenate([u, u[:, :1] + 1.0], axis=1), axis=1)
     widest = gaps.argmax(axis=1)
-    start = u[np.arange(len(u)), (widest + 1) % 3] * width
+    bounds = np.zeros((4, n))
+    bounds[:, seen] = rows.min(axis=1), rows.max(axis=1), u[np.arange(len(u)), (widest + 1) % 3], 1.0 - gaps.max(axis=1)
+    north, south = (edge_normals[..., 2] >= 0.0).all(axis=1) & seen, (edge_normals[..., 2] <= 0.0).all(axis=1) & seen
+    normal = np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0])
+    return Projection(seen, edge_normals, normal, np.einsum("tc,tc->t", normal, triangles[:, 0]), *bounds, north,
+                      south)
+
+
+def _uv_window(p: Projection, width: int, height: int) -> tuple[np.ndarray, ...]:
+    """Pixel windows (row0, rows, col0, cols) holding the centres of every pixel that the
+    triangles of the projection `p` may cover, widened by `_MARGIN` pixel; rows or cols 0
+    where they cover none."""
+    # Pixel r's centre lies at r + 0.5 rows (columns) from the top (the seam).
+    row0 = np.maximum(np.ceil(p.top * height - 0.5 - _MARGIN), 0).astype(np.int64)
+    row1 = np.minimum(np.floor(p.bottom * height - 0.5 + _MARGIN), height - 1).astype(np.int64)
+    start = p.start * width
     col0 = np.ceil(start - 0.5 - _MARGIN).astype(np.int64)
-    cols = np.floor(start + (1.0 - gaps.max(axis=1)) * width - 0.5 + _MARGIN).astype(np.int64) - col0 + 1
+    cols = np.floor(start + p.span * width - 0.5 + _MARGIN).astype(np.int64) - col0 + 1
     # A triangle around a pole covers every column near that pole.
-    north, south = (edge_normals[..., 2] >= 0.0).all(axis=1), (edge_normals[..., 2] <= 0.0).all(axis=1)
-    row0, row1 = np.where(north, 0, row0), np.where(south, height - 1, row1)
-    col0, cols = np.where(north | south, 0, col0), np.where(north | south, width, cols)
+    row0, row1 = np.where(p.north, 0, row0), np.where(p.south, height - 1, row1)
+    col0, cols = np.where(p.north | p.south, 0, col0), np.where(p.north | p.south, width, cols)
     return row0, np.maximum(row1 - row0 + 1, 0), np.mod(col0, width), np.clip(cols, 0, width)
 
 
-def _edge_extreme_rows(tris: np.ndarray, height: int) -> np.ndarray:
-    """(T, 3) the panorama row (continuous) of each edge's interior extreme of elevation.
+def _edge_extreme_rows(tris: np.ndarray) -> np.ndarray:
+    """(T, 3) the row share (polar angle / pi) of each edge's interior extreme of elevation.
 
     Along p(t) = a + t (b - a) the elevation z / |p| has one stationary point, where
     t = (a_z a.e - e_z |a|^2) / (e_z a.e - a_z |e|^2); clipped to the edge, it is an endpoint
@@ -78,7 +118,7 @@ def _edge_extreme_rows(tris: np.ndarray, height: int) -> np.ndarray:
         t = np.where(np.abs(den) > 0.0, num / den, 0.0)
     p = a + np.clip(np.nan_to_num(t), 0.0, 1.0)[..., None] * e
     z = p[..., 2] / np.maximum(np.linalg.norm(p, axis=2), 1e-300)
-    return np.arccos(np.clip(z, -1.0, 1.0)) / np.pi * height
+    return np.arccos(np.clip(z, -1.0, 1.0)) / np.pi
 
 
 def _edge_normals(tris: np.ndarray) -> np.ndarray:
@@ -183,11 +223,13 @@ def _batches(pixels: np.ndarray) -> list[slice]:
 
 
 def trace_panorama(triangles: np.ndarray, width: int, height: int, *,
-                   window: tuple[int, int, int, int] | None = None) -> PanoramaHits:
+                   window: tuple[int, int, int, int] | None = None,
+                   projection: Projection | None = None) -> PanoramaHits:
     """First hit of each pixel centre's ray from the origin among `triangles` (T, 3, 3), over
     the whole W x H panorama or only its `window` (first row, rows, first column, columns;
     the columns wrap around the seam): the hits then have the window's shape. Where two
-    triangles meet a ray at the same depth, the first of them is hit.
+    triangles meet a ray at the same depth, the first of them is hit. `projection`: the
+    triangles' `project`, where the caller holds it.
 
     Each triangle is tested at the pixels of its exact window (`_uv_window`), batches of
     triangles at once: the cost follows the pixels the triangles cover and their count, so
@@ -196,19 +238,15 @@ def trace_panorama(triangles: np.ndarray, width: int, height: int, *,
     dirs = window_directions(width, height, (row_start, nrows_w, col_start, ncols_w))
     best = np.full((nrows_w, ncols_w), np.inf)
     out = {"tri": np.full((nrows_w, ncols_w), -1, dtype=np.int64), "bary": np.zeros((nrows_w, ncols_w, 2))}
-    det = np.einsum("ij,ij->i", triangles[:, 0], np.cross(triangles[:, 1], triangles[:, 2]))
-    scale = np.linalg.norm(triangles, axis=2).max(axis=1) ** 3
-    seen = np.flatnonzero(np.abs(det) > 1e-12 * scale)  # edge-on triangles cover no pixel centre
-    edge_normals = np.zeros((len(triangles), 3, 3))
-    edge_normals[seen] = _edge_normals(triangles[seen])
-    row0, nrows, col0, ncols = _uv_window(triangles[seen], edge_normals[seen], width, height)
+    p = project(triangles) if projection is None else projection
+    seen = np.flatnonzero(p.seen)
+    row0, nrows, col0, ncols = _uv_window(p.take(seen), width, height)
     # Only the rows inside the window are worth testing.
     row1 = np.minimum(row0 + nrows, row_start + nrows_w)
     row0 = np.maximum(row0, row_start)
     some = np.flatnonzero((row1 > row0) & (ncols > 0))
     windows = _Windows(seen[some], row0[some], (row1 - row0)[some], col0[some], ncols[some]).split(_BATCH_PIXELS)
-    normal = np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0])
-    planes = (edge_normals, normal, np.einsum("tc,tc->t", normal, triangles[:, 0]))
+    planes = (p.edge_normals, p.normal, p.offset)
     for batch in _batches(windows.pixels):
         # In the triangles' order: the earlier batch keeps a tie of depth.
         _rasterise(planes, windows.take(batch), dirs, (row_start, col_start, width), best, out)

@@ -72,7 +72,7 @@ def object_window(geo: Geometry, target: Target, hidden_working: np.ndarray, cov
     ncols = width if cols == w else min(width, int(np.ceil(cols * scale)))
     window = (row_start, row_stop - row_start, col_start, ncols)
     on = np.flatnonzero(geo.tri_object == target.index)
-    obj = trace_panorama(geo.triangles[on], width, height, window=window)
+    obj = trace_panorama(geo.triangles[on], width, height, window=window, projection=geo.projection.take(on))
     # float32 and int32: a window of millions of pixels is the largest thing the run holds
     # besides the panorama and its difference; a metre in float32 is exact to a micron.
     object_distance = np.where(obj.tri >= 0, obj.distance, np.inf).astype(np.float32)

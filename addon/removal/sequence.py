@@ -16,7 +16,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..callbacks import NO_CALLBACKS, RunCallbacks
-from ..geometry.mesh import Geometry, build_geometry
+from ..geometry.mesh import Geometry
 from ..quality import Params
 from ..report import Report
 from ..scene import SceneData
@@ -35,7 +35,7 @@ from .relit_noise import relit_noise_stage
 from .room import solve_room
 from .seam import seamless_panorama_change
 from .solution import Solution
-from .target import Target, object_index, prepare
+from .target import Target, object_index, prepare, scene_geometry
 from .trace import Traced, trace
 from .working import downsample, working_size
 
@@ -62,15 +62,16 @@ class RemovalResult:
 
 
 def photographed(scene: SceneData, object_name: str, params: Params, rep: Report, *,
-                 mask: UserMask | None = None) -> SeenObject | None:
+                 mask: UserMask | None = None, geo: Geometry | None = None) -> SeenObject | None:
     """The object as the scene's panorama shows it, segmented around its proxy, with the
     artist's `mask` applied; None when no pixel sees it, or when the preset's band is 0 and
-    there is no mask (the proxy's silhouette is filled then)."""
+    there is no mask (the proxy's silhouette is filled then). `geo`: the scene's geometry,
+    where the caller has built it."""
     index = object_index(scene, object_name)
     if params.segmentation_band <= 0 and mask is None:
         return None
     with rep.stage("segmentation"):
-        geo = build_geometry(scene.triangles, scene.tri_object, scene.object_names, scene.center, scene.rotation)
+        geo = geo if geo is not None else scene_geometry(scene)
         if not (geo.tri_object == index).any():
             return None
         band = params.segmentation_band
@@ -78,12 +79,13 @@ def photographed(scene: SceneData, object_name: str, params: Params, rep: Report
 
 
 def traced_scene(scene: SceneData, object_name: str, planes: list[str] | tuple[str, ...], params: Params,
-                 rep: Report, callbacks: RunCallbacks, *, fill: bool = True, seen: SeenObject | None = None
-                 ) -> tuple[Geometry, Target, Traced]:
-    """The geometry, the target and what the pixels see. Without `fill` (an insertion has
-    nothing to fill) the pixels around the object are relit like the rest; with it, the
-    pixels `seen` shows the object in are filled (default: the proxy's silhouette)."""
-    geo, target = prepare(scene, object_name, planes, params, rep)
+                 rep: Report, callbacks: RunCallbacks, *, fill: bool = True, seen: SeenObject | None = None,
+                 geo: Geometry | None = None) -> tuple[Geometry, Target, Traced]:
+    """The geometry (`geo` where the caller has built it), the target and what the pixels
+    see. Without `fill` (an insertion has nothing to fill) the pixels around the object are
+    relit like the rest; with it, the pixels `seen` shows the object in are filled (default:
+    the proxy's silhouette)."""
+    geo, target = prepare(scene, object_name, planes, params, rep, geo=geo)
     height, width = scene.hdri.shape[:2]
     with rep.stage("trace"):
         shown = None if seen is None else seen.whole(height, width)
@@ -115,9 +117,12 @@ def solve_lighting(hdri: np.ndarray, geo: Geometry, target: Target, traced: Trac
 
 
 def solve(scene: SceneData, object_name: str, planes: list[str] | tuple[str, ...], params: Params, rep: Report,
-          callbacks: RunCallbacks = NO_CALLBACKS, *, fill: bool = True, seen: SeenObject | None = None) -> Solution:
-    """Every stage of the removal up to the new irradiance of each pixel."""
-    geo, target, traced = traced_scene(scene, object_name, planes, params, rep, callbacks, fill=fill, seen=seen)
+          callbacks: RunCallbacks = NO_CALLBACKS, *, fill: bool = True, seen: SeenObject | None = None,
+          geo: Geometry | None = None) -> Solution:
+    """Every stage of the removal up to the new irradiance of each pixel (`geo`: the scene's
+    geometry, where the caller has built it)."""
+    geo, target, traced = traced_scene(scene, object_name, planes, params, rep, callbacks, fill=fill, seen=seen,
+                                       geo=geo)
     return solve_lighting(scene.hdri, geo, target, traced, params, rep, callbacks, seen=seen)
 
 
@@ -170,13 +175,18 @@ def remove(scene: SceneData, object_name: str, *, planes: list[str] | tuple[str,
     # Above the working width the compose stage gives way to downsample, window, upsample and refine.
     rep = Report(callbacks.progress, stages=STAGES + 3 * full_size)
     rep.info["working_resolution"] = list(size)
-    seen = photographed(scene, object_name, params, rep, mask=mask)
+    # Built once: the segmentation and the solve trace the same triangles (the working copy
+    # has the scene's), and a mesh of 200k triangles takes a fifth of a second to build and
+    # as much again to project for its traces (`Geometry.projection`).
+    with rep.stage("geometry"):
+        geo = scene_geometry(scene)
+    seen = photographed(scene, object_name, params, rep, mask=mask, geo=geo)
     callbacks.check()
     if not full_size:
-        return finish(solve(scene, object_name, planes, params, rep, callbacks, seen=seen), rep, callbacks)
+        return finish(solve(scene, object_name, planes, params, rep, callbacks, seen=seen, geo=geo), rep, callbacks)
     with rep.stage("downsample"):
         working = replace(scene, hdri=downsample(scene.hdri, *size))
-    solution = solve(working, object_name, planes, params, rep, callbacks, seen=seen)
+    solution = solve(working, object_name, planes, params, rep, callbacks, seen=seen, geo=geo)
     if callbacks.preview is not None:
         callbacks.show(_hit_image(solution.traced, compose(solution, Report())))
     return finish_full_size(solution, scene.hdri, rep, callbacks)

@@ -30,12 +30,13 @@ class Target:
 
 
 def prepare(scene: SceneData, object_name: str, planes: list[str] | tuple[str, ...], params: Params,
-            rep: Report) -> tuple[Geometry, Target]:
-    """The scene's triangles in the probe frame and the object to remove; DimredError when the
-    object or a --plane is unknown, the object has no faces or a --plane is not flat."""
+            rep: Report, *, geo: Geometry | None = None) -> tuple[Geometry, Target]:
+    """The scene's triangles in the probe frame (`geo` where the caller has built them) and the
+    object to remove; DimredError when the object or a --plane is unknown, the object has no
+    faces or a --plane is not flat."""
     index = object_index(scene, object_name)
     with rep.stage("geometry"):
-        geo = build_geometry(scene.triangles, scene.tri_object, scene.object_names, scene.center, scene.rotation)
+        geo = geo if geo is not None else scene_geometry(scene)
         if not (geo.tri_object == index).any():
             raise DimredError(f"'{object_name}' has no faces to remove")
         plane_ids = tuple(_plane_index(geo, name) for name in planes)
@@ -52,6 +53,11 @@ def prepare(scene: SceneData, object_name: str, planes: list[str] | tuple[str, .
     shadow_cell = int(np.clip(radius / pixel / SHADOW_CELLS_PER_RADIUS, 1, params.shadow_cell))
     return geo, Target(index=index, planes=plane_ids, centre=centre, radius=radius, fine_cell=fine_cell,
                        shadow_cell=shadow_cell, eps=1e-6 * geo.scale, surface_key=surface_keys(geo))
+
+
+def scene_geometry(scene: SceneData) -> Geometry:
+    """The scene's triangles in the probe frame (`build_geometry`)."""
+    return build_geometry(scene.triangles, scene.tri_object, scene.object_names, scene.center, scene.rotation)
 
 
 def object_index(scene: SceneData, object_name: str) -> int:

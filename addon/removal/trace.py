@@ -65,7 +65,7 @@ def trace(geo: Geometry, target: Target, width: int, height: int, *, fill: bool,
     (H, W) bool: the photograph's object, default the proxy's silhouette) and the pixels around
     them are hidden (filled, not relit), and what is behind them is traced. Pixels of the
     proxy outside `shown` are kept as the photograph shows them."""
-    hits = trace_panorama(geo.triangles, width, height)
+    hits = trace_panorama(geo.triangles, width, height, projection=geo.projection)
     flat_tri = hits.tri.ravel()
     hp = np.flatnonzero(flat_tri >= 0)
     tri_h = flat_tri[hp]
@@ -102,7 +102,7 @@ def _behind(geo: Geometry, target: Target, width: int, height: int, hp: np.ndarr
             rep: Report) -> Behind:
     """The surfaces to fill: what the hidden pixels see once the object is gone."""
     keep = np.flatnonzero(geo.tri_object != target.index)
-    hits = trace_panorama(geo.triangles[keep], width, height)
+    hits = trace_panorama(geo.triangles[keep], width, height, projection=geo.projection.take(keep))
     flat = hits.tri.ravel()
     tri_without = np.full(height * width, -1, dtype=np.int64)
     tri_without[flat >= 0] = keep[flat[flat >= 0]]

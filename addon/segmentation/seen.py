@@ -16,7 +16,7 @@ from ..errors import DimredError
 from ..geometry import latlong
 from ..geometry.mesh import Geometry
 from ..geometry.planeraster import Frame
-from ..geometry.raycast import trace_panorama
+from ..geometry.raycast import Projection, trace_panorama
 from ..geometry.span import pixel_span
 from ..light.radiosity import LUMA
 from ..report import Report
@@ -108,7 +108,8 @@ def seen_object(hdri: np.ndarray, geo: Geometry, index: int, *, segment: bool = 
     proxy does not lie over anything the photograph shows as an object there."""
     height, width = hdri.shape[:2]
     on = geo.tri_object == index
-    spot = _coarse_spot(geo.triangles[on], mask, width, height)
+    projection = geo.projection  # before the two threads below, so it is worked out once
+    spot = _coarse_spot(geo.triangles[on], projection.take(on), mask, width, height)
     if spot is None:
         return None
     centre = geo.triangles[on].reshape(-1, 3)
@@ -123,8 +124,9 @@ def seen_object(hdri: np.ndarray, geo: Geometry, index: int, *, segment: bool = 
     frame, shape = _window(spot, band_px + _PAD, hs, ws)
     window = (frame.row0, shape[0], frame.col0, shape[1])
     # The object and the rest are traced side by side (at 8K each is a window of 500k pixels).
-    obj, others = both(lambda: trace_panorama(geo.triangles[on], ws, hs, window=window),
-                       lambda: trace_panorama(geo.triangles[~on], ws, hs, window=window))
+    obj, others = both(
+        lambda: trace_panorama(geo.triangles[on], ws, hs, window=window, projection=projection.take(on)),
+        lambda: trace_panorama(geo.triangles[~on], ws, hs, window=window, projection=projection.take(~on)))
     proxy = (obj.tri >= 0) & ((others.tri < 0) | (obj.distance < others.distance))
     image = _window_image(hdri, frame, shape, factor)
     seg = None
@@ -162,12 +164,13 @@ def seen_object(hdri: np.ndarray, geo: Geometry, index: int, *, segment: bool = 
     return seen
 
 
-def _coarse_spot(tris: np.ndarray, mask: UserMask | None, width: int, height: int) -> np.ndarray | None:
+def _coarse_spot(tris: np.ndarray, projection: Projection, mask: UserMask | None, width: int, height: int
+                 ) -> np.ndarray | None:
     """(hc, wc) bool: where the object (its raster and its vertices, so no sliver is missed)
     and the user's added pixels are at a coarse resolution; None when nowhere."""
     wc = min(width, _COARSE_WIDTH)
     hc = wc // 2
-    spot = trace_panorama(tris, wc, hc).tri >= 0
+    spot = trace_panorama(tris, wc, hc, projection=projection).tri >= 0
     spot[latlong.uv_to_pixel(*latlong.direction_to_uv(tris.reshape(-1, 3)), wc, hc)] = True
     if mask is not None and mask.add.any():
         spot |= mask.in_frame(Frame(0, 0, hc, wc), (hc, wc))[0] | _scattered(mask.add, hc, wc)

@@ -46,3 +46,19 @@ def test_every_witness_is_checked_not_only_the_sample():
     assert mesh._all_on_lit_side(witnesses, normals, offsets, 1e-9)
     witnesses[1001, 2] = -1.0
     assert not mesh._all_on_lit_side(witnesses, normals, offsets, 1e-9)
+
+
+def test_surface_keys_number_the_planes_of_each_object_in_order():
+    geo = _geometry(box_split=4)
+    keys = mesh.surface_keys(geo)
+    box = geo.tri_object == geo.object_names.index("Box")
+    # A box split into 16 triangles a face: six planes, each face's triangles sharing one key.
+    assert len(np.unique(keys[box])) == 6
+    normals = np.round(geo.normals[box], 6)
+    for key in np.unique(keys[box]):
+        assert len(np.unique(normals[keys[box] == key], axis=0)) == 1
+    assert not set(keys[box]) & set(keys[~box])
+    # The keys are 0..K-1 in the order of (object, normal, offset), as np.unique numbers rows.
+    assert set(keys) == set(range(keys.max() + 1))
+    order = [geo.tri_object[np.flatnonzero(keys == k)[0]] for k in range(keys.max() + 1)]
+    assert order == sorted(order)

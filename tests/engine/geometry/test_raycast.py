@@ -71,3 +71,24 @@ def test_first_hits_and_crossings_of_a_unit_cube():
     assert set(cube[index[0]][:, 2]) == {0.0} and set(cube[index[1]][:, 2]) == {1.0}
     count = crossings(np.array([[0.3, 0.6, -1.0], [0.3, 0.6, 0.5], [2.0, 2.0, 0.5]]), up, cube)
     assert count.tolist() == [2, 1, 0]
+
+
+def test_a_projection_taken_once_traces_every_subset_window_and_size_alike():
+    from addon.geometry.patches import split_triangles
+    from addon.geometry.raycast import project
+
+    fine = split_triangles(box([-1.4, -0.3, -1.2], [-0.8, 0.3, -0.4]), 8).reshape(-1, 3, 3)
+    tris = np.concatenate([ROOM, fine, box([-0.2, -0.2, -1.5], [0.2, 0.2, -1.2])])  # across the seam, at the nadir
+    edge_on = np.array([[[1.0, 0.0, 0.0], [2.0, 0.0, 0.0], [3.0, 0.0, 0.5]]])  # in a plane through the probe
+    tris = np.concatenate([tris, edge_on])
+    projection = project(tris)
+    assert not projection.seen[-1] and projection.seen[:-1].all()
+    pick = np.flatnonzero(np.arange(len(tris)) % 3 != 1)
+    for width, window in ((64, None), (256, None), (256, (60, 40, 240, 32)), (1024, (400, 112, 900, 300))):
+        for subset in (slice(None), pick):
+            alone = trace_panorama(tris[subset], width, width // 2, window=window)
+            given = trace_panorama(tris[subset], width, width // 2, window=window,
+                                   projection=projection.take(subset))
+            np.testing.assert_array_equal(given.tri, alone.tri)
+            np.testing.assert_array_equal(given.distance, alone.distance)
+            np.testing.assert_array_equal(given.bary, alone.bary)
