@@ -34,6 +34,9 @@ class Params:
     shadow_cell: int = 4
     bright_factor: float = 4.0  # important senders are this many times brighter than the median patch
     patch_samples: int = 2  # k*k points average the first-order change over patches near the object
+    # a group of a detailed object's triangles sends its light as one point patch beyond this
+    # many times its radius (`light.aggregate`): smaller is faster beside a 200k-triangle mesh
+    aggregate_far: float = 6.0
     max_bounces: int = 8  # propagation of the change around the room
     bounce_tolerance: float = 2e-3  # stop when a bounce adds less than this share
     # plane raster cell, in panorama pixel footprints where the object was: finer keeps more detail, slower
@@ -78,8 +81,8 @@ DESCRIPTIONS = {
 
 PRESETS = {
     "draft": Params(patches=200, object_patches=40, sender_fraction=0.9, max_senders=12, sender_samples=2,
-                    fine_cells=2.0, fine_pixels=8.0, reach=0.15, significance=0.03, patch_samples=1, max_bounces=4,
-                    bounce_tolerance=1e-2, refine_pixels=50_000, working_width=512),
+                    fine_cells=2.0, fine_pixels=8.0, reach=0.15, significance=0.03, patch_samples=1, aggregate_far=3.0,
+                    max_bounces=4, bounce_tolerance=1e-2, refine_pixels=50_000, working_width=512),
     "balanced": Params(),
     # Balanced's patches, patch samples, neighbourhood and bounce tolerance: more of any of them
     # cost up to 3x and left the error against the ground-truth renders no lower on every scene
@@ -115,8 +118,8 @@ def working_width_problem(width: object) -> str | None:
 
 # The solver's accuracy knobs (not the synthesis's, not the relocation's passes).
 _SOLVER_FIELDS = ("patches", "object_patches", "sender_fraction", "max_senders", "sender_samples", "fine_cells",
-                  "fine_pixels", "reach", "significance", "shadow_cell", "patch_samples", "max_bounces",
-                  "bounce_tolerance")
+                  "fine_pixels", "reach", "significance", "shadow_cell", "patch_samples", "aggregate_far",
+                  "max_bounces", "bounce_tolerance")
 
 
 def rough(params: Params) -> Params:

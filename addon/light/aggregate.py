@@ -21,7 +21,7 @@ from ..geometry.solid import in_frame, principal_frame
 from .formfactor import paired_point_to_triangle
 
 BRANCH = 4  # groups of BRANCH, BRANCH^2, ... member triangles, each group made of BRANCH smaller ones
-FAR = 6.0  # a point patch beyond this many times its radius
+FAR = 6.0  # a point patch beyond this many times its radius (the default of `form_factors`)
 _RECEIVERS = 256  # receivers taken at once: bounds the (receiver, group) pairs held
 _HORIZON = 1e-9  # height over a receiver's tangent plane below which nothing is received (as `formfactor`)
 
@@ -111,17 +111,25 @@ class _Members:
         length = np.sqrt(np.einsum("ij,ij->i", vector, vector))
         has_axis = length > 1e-12 * total
         axis = np.where(has_axis[:, None], vector / np.maximum(length, 1e-300)[:, None], 0.0)
-        reach2 = np.zeros(len(run))
-        along = np.zeros((len(run), 3))
+        # Each member's run's centre and axis gathered once; minima and maxima of three columns
+        # taken pairwise (a reduction over an axis of 3 is numpy's slow path): a mesh of 200k
+        # triangles builds its seven levels in half the time.
+        centres, axes = centre[run], axis[run]
+        reach2, least, most = None, None, None
         for k in range(3):
-            gap = self.triangles[:, k] - centre[run]
-            reach2 = np.maximum(reach2, np.einsum("ij,ij->i", gap, gap))
-            along[:, k] = np.einsum("ij,ij->i", self.triangles[:, k], axis[run])
-        turn = self.normals - axis[run]
+            gap = self.triangles[:, k] - centres
+            dist2 = np.einsum("ij,ij->i", gap, gap)
+            height = np.einsum("ij,ij->i", self.triangles[:, k], axes)
+            if reach2 is None:
+                reach2, least, most = dist2, height, height.copy()
+            else:
+                np.maximum(reach2, dist2, out=reach2)
+                np.minimum(least, height, out=least)
+                np.maximum(most, height, out=most)
+        turn = self.normals - axes
         # A run whose normals cancel has no axis: the spread of 2 keeps it from ever counting as a point patch.
         spread = np.where(has_axis, np.sqrt(np.maximum.reduceat(np.einsum("ij,ij->i", turn, turn), first)), 2.0)
-        offsets = np.stack([np.minimum.reduceat(along.min(axis=1), first),
-                            np.maximum.reduceat(along.max(axis=1), first)], axis=1)
+        offsets = np.stack([np.minimum.reduceat(least, first), np.maximum.reduceat(most, first)], axis=1)
         lo, hi = np.minimum.reduceat(self.lo, first), np.maximum.reduceat(self.hi, first)
         return Aggregates(centre, np.sqrt(np.maximum.reduceat(reach2, first)), 0.5 * (lo + hi), 0.5 * (hi - lo),
                           vector, axis, spread, offsets)
@@ -138,8 +146,10 @@ def _morton(points: np.ndarray) -> np.ndarray:
     return code
 
 
-def form_factors(points: np.ndarray, normals: np.ndarray, h: Hierarchy) -> np.ndarray:
-    """(R, C) form factors from receivers (R, 3) with unit normals (R, 3) to the senders."""
+def form_factors(points: np.ndarray, normals: np.ndarray, h: Hierarchy, *, far: float = FAR) -> np.ndarray:
+    """(R, C) form factors from receivers (R, 3) with unit normals (R, 3) to the senders, a
+    group taken as a point patch beyond `far` times its radius (relative error about
+    (radius / distance)^2: over a box's receivers 0.2 % on average at 6, 0.5 % at 3)."""
     count = len(h.levels[0].radius)
     out = np.zeros((len(points), count))
     for r0 in range(0, len(points), _RECEIVERS):
@@ -148,7 +158,7 @@ def form_factors(points: np.ndarray, normals: np.ndarray, h: Hierarchy) -> np.nd
         f = np.zeros(len(x) * count)
         rows, items = np.repeat(np.arange(len(x)), count), np.tile(np.arange(count), len(x))
         for agg, children, sender in zip(h.levels, h.children, h.sender, strict=True):
-            value, near = _point_patches(x[rows], n[rows], xf[rows], nf[rows], agg, items)
+            value, near = _point_patches(x[rows], n[rows], xf[rows], nf[rows], agg, items, far)
             f += np.bincount(rows * count + sender[items], value, minlength=f.size)
             rows, items = _expand(rows[near], items[near], children)
         exact = paired_point_to_triangle(x[rows], n[rows], h.triangles[items], h.normals[items])
@@ -157,8 +167,8 @@ def form_factors(points: np.ndarray, normals: np.ndarray, h: Hierarchy) -> np.nd
     return out
 
 
-def _point_patches(x: np.ndarray, n: np.ndarray, xf: np.ndarray, nf: np.ndarray, agg: Aggregates, k: np.ndarray
-                   ) -> tuple[np.ndarray, np.ndarray]:
+def _point_patches(x: np.ndarray, n: np.ndarray, xf: np.ndarray, nf: np.ndarray, agg: Aggregates, k: np.ndarray,
+                   far: float) -> tuple[np.ndarray, np.ndarray]:
     """Pairs of receivers x (P, 3) with unit normals n (P, 3) (xf, nf: in the hierarchy's
     frame) and aggregates k (P,): the form factor (P,) where the aggregate is a point patch
     for the receiver (0 where it sends nothing) and (P,) where it is neither, so it must be
@@ -183,7 +193,7 @@ def _point_patches(x: np.ndarray, n: np.ndarray, xf: np.ndarray, nf: np.ndarray,
     # The contour formula clips at _HORIZON: members no higher send nothing there either, and
     # one touching the horizon loses only a sliver to it.
     nothing = (highest <= _HORIZON) | (farthest <= 0.0)
-    point = (lowest >= -_HORIZON) & (nearest > 0.0) & (d > FAR * radius)
+    point = (lowest >= -_HORIZON) & (nearest > 0.0) & (d > far * radius)
     flux = over_centre * np.einsum("ij,ij->i", agg.vector[k], v)
     value = np.divide(flux, np.pi * d2 * d2, out=np.zeros(len(v)), where=point)
     return value, ~(nothing | point)

@@ -35,6 +35,7 @@ class Parts:
     triangles: np.ndarray  # (T, 3, 3)
     normals: np.ndarray  # (T, 3)
     owner: np.ndarray  # (T,) sender of each member
+    far: float = aggregate.FAR  # a group of members is a point patch beyond this many times its radius
 
     @cached_property
     def clustered(self) -> np.ndarray:
@@ -92,7 +93,8 @@ class Senders:
             row = np.full(len(self), -1)
             row[idx] = np.arange(len(idx))
             keep = row[self.parts.owner] >= 0
-            parts = Parts(self.parts.triangles[keep], self.parts.normals[keep], row[self.parts.owner[keep]])
+            parts = Parts(self.parts.triangles[keep], self.parts.normals[keep], row[self.parts.owner[keep]],
+                          self.parts.far)
         return Senders(self.triangles[idx], self.normals[idx], self.radiosity[idx], self.on_removed[idx],
                        self.group[idx], self.slot[idx], self.samples, self.weights, parts)
 
@@ -123,7 +125,7 @@ def form_factors(points: np.ndarray, normals: np.ndarray, senders: Senders) -> n
     f[:, single], f[:, parts.clustered] = both(
         lambda: point_to_triangle(points, normals, senders.triangles[single], senders.normals[single]),
         lambda: aggregate.form_factors(np.asarray(points, dtype=np.float64), np.asarray(normals, dtype=np.float64),
-                                       parts.hierarchy))
+                                       parts.hierarchy, far=parts.far))
     return f
 
 

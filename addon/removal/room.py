@@ -139,7 +139,7 @@ def _patches(geo: Geometry, target: Target, traced: Traced, params: Params, rep:
         patch_tri = np.concatenate([patch_tri, obj[clusters.representative]])
         areas = np.concatenate([areas, clusters.area])
         corners = np.concatenate([corners, np.zeros((len(clusters.area), 3), dtype=np.int64)])
-        parts = Parts(geo.triangles[obj], geo.normals[obj], lat.n_patches + clusters.label)
+        parts = Parts(geo.triangles[obj], geo.normals[obj], lat.n_patches + clusters.label, params.aggregate_far)
         members, member_weights = visibility_samples(clusters, geo.triangles[obj].mean(axis=1), geo.areas[obj],
                                                      k=params.patch_samples ** 2)
         rep.info["object_clusters"] = len(clusters.area)

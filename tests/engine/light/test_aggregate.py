@@ -95,3 +95,31 @@ def test_a_single_member_sender_and_a_coarse_mesh_are_exact():
     dirs = np.array([[0.0, 0.0, 1.0], [-1.0, 0.0, 0.0], [0.6, 0.0, -0.8]])
     np.testing.assert_allclose(aggregate.form_factors(points, dirs, tree), _exact(points, dirs, tris, normals, owner),
                                rtol=1e-12, atol=1e-15)
+
+
+def test_a_nearer_point_patch_threshold_opens_fewer_groups_beside_a_fine_mesh_within_two_percent(monkeypatch):
+    # Floor points a few millimetres to 5 cm from a box of 10,800 triangles: where a draft
+    # refines its contact shadow, and where the groups opened cost the most.
+    tris = split_triangles(box_triangles([-0.25, -0.25, 0.0], [0.25, 0.25, 0.5]), 30).reshape(-1, 3, 3)
+    normals = _normals(tris)
+    normals = np.where((np.einsum("ij,ij->i", normals, tris.mean(axis=1) - [0, 0, 0.25]) < 0)[:, None], -normals,
+                       normals)
+    owner = _senders(tris, 40)
+    tree = aggregate.hierarchy(tris, normals, owner, owner.max() + 1)
+    rng = np.random.default_rng(1)
+    angle, gap = rng.uniform(0, 2 * np.pi, 300), rng.uniform(0.005, 0.05, 300)
+    along = np.stack([np.cos(angle), np.sin(angle)], axis=1)
+    points = np.concatenate([along * (0.25 / np.abs(along).max(axis=1) + gap)[:, None], np.zeros((300, 1))], axis=1)
+    up = np.tile([0.0, 0.0, 1.0], (len(points), 1))
+    exact = _exact(points, up, tris, normals, owner).sum(axis=1)
+    tested = []
+    point_patches = aggregate._point_patches
+    monkeypatch.setattr(aggregate, "_point_patches", lambda *a: (tested.append(len(a[0])), point_patches(*a))[1])
+    error = {}
+    for far in (aggregate.FAR, 3.0):
+        tested.clear()
+        got = aggregate.form_factors(points, up, tree, far=far).sum(axis=1)
+        error[far] = (np.abs(got - exact) / exact, sum(tested))
+    (fine, opened_fine), (coarse, opened_coarse) = error.values()
+    assert opened_coarse < 0.97 * opened_fine
+    assert fine.mean() < coarse.mean() < 0.01 and coarse.max() < 0.02
