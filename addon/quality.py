@@ -61,6 +61,9 @@ class Params:
     # this wide (a share of the object's angular size): wide enough for a proxy placed by eye a
     # few centimetres, degrees and percent off; 0 turns the segmentation off (the proxy decides)
     segmentation_band: float = 0.12
+    # ... on the panorama's own pixels up to a window of this many, beyond it on a copy averaged
+    # over 2 x 2 of them (4 x 4, ...): a close object at 8K is a window of half a million
+    segmentation_pixels: int = 1 << 20
     # relocation: solver passes towards the inserted object's fixed point (2 at least: the first
     # lacks the object's reflected light)
     insertion_passes: int = 2
@@ -82,7 +85,8 @@ DESCRIPTIONS = {
 PRESETS = {
     "draft": Params(patches=200, object_patches=40, sender_fraction=0.9, max_senders=12, sender_samples=2,
                     fine_cells=2.0, fine_pixels=8.0, reach=0.15, significance=0.03, patch_samples=1, aggregate_far=3.0,
-                    max_bounces=4, bounce_tolerance=1e-2, refine_pixels=50_000, working_width=512),
+                    max_bounces=4, bounce_tolerance=1e-2, refine_pixels=50_000, working_width=512,
+                    segmentation_pixels=1 << 18),
     "balanced": Params(),
     # Balanced's patches, patch samples, neighbourhood and bounce tolerance: more of any of them
     # cost up to 3x and left the error against the ground-truth renders no lower on every scene

@@ -75,7 +75,8 @@ def photographed(scene: SceneData, object_name: str, params: Params, rep: Report
         if not (geo.tri_object == index).any():
             return None
         band = params.segmentation_band
-        return seen_object(scene.hdri, geo, index, segment=band > 0, band=max(band, 0.0), mask=mask, rep=rep)
+        return seen_object(scene.hdri, geo, index, segment=band > 0, band=max(band, 0.0),
+                           max_pixels=params.segmentation_pixels, mask=mask, rep=rep)
 
 
 def traced_scene(scene: SceneData, object_name: str, planes: list[str] | tuple[str, ...], params: Params,

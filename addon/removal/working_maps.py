@@ -23,7 +23,9 @@ class WorkingMaps:
     emitter: np.ndarray  # bool: it sees a light source
     e: np.ndarray  # (h*w, 3) float32 E with the object (0 where not valid)
     de: np.ndarray  # (h*w, 3) float32 dE
-    tri_without: np.ndarray  # the triangle it sees without the object (-1 for none)
+    # (h*w, K) the distinct triangles its 3 x 3 neighbourhood sees without the object, in the
+    # neighbourhood's order, then -1: what a full-resolution pixel nearest to it may see
+    candidates: np.ndarray
 
 
 def working_maps(solution: Solution) -> WorkingMaps:
@@ -40,7 +42,25 @@ def working_maps(solution: Solution) -> WorkingMaps:
     e = np.zeros((n, 3), dtype=np.float32)
     de = np.zeros((n, 3), dtype=np.float32)
     e[traced.hp], de[traced.hp] = solution.e_h, solution.de_h
-    return WorkingMaps(traced.width, traced.height, key, valid, emitter, e, de, traced.behind.tri_without)
+    return WorkingMaps(traced.width, traced.height, key, valid, emitter, e, de, _neighbourhood_triangles(
+        traced.behind.tri_without, traced.height, traced.width))
+
+
+def _neighbourhood_triangles(tri: np.ndarray, height: int, width: int) -> np.ndarray:
+    """(h*w, K) the distinct triangles of `tri` (h*w,) in each pixel's 3 x 3 neighbourhood
+    (wrapping around the seam, clamped at the poles), first ones first, -1 after them; K the
+    most any neighbourhood holds. At a room's edges they are two or three of the nine: the
+    full-resolution pixels there test those alone."""
+    grid = tri.reshape(height, width)
+    rows = np.arange(height)
+    near = np.stack([np.roll(grid[np.clip(rows + dy, 0, height - 1)], -dx, axis=1).ravel()
+                     for dy in (-1, 0, 1) for dx in (-1, 0, 1)], axis=1)
+    repeat = near < 0
+    for j in range(1, near.shape[1]):
+        repeat[:, j] |= (near[:, :j] == near[:, j:j + 1]).any(axis=1)
+    order = np.argsort(repeat, axis=1, kind="stable")
+    distinct = np.take_along_axis(np.where(repeat, -1, near), order, axis=1)
+    return distinct[:, :max(1, int((~repeat).sum(axis=1).max()))]
 
 
 @dataclass(frozen=True)
@@ -105,13 +125,9 @@ def neighbours(rows: np.ndarray, cols: np.ndarray, full: tuple[int, int], maps: 
 def surfaces_seen(directions: np.ndarray, nearest: np.ndarray, geo: Geometry, maps: WorkingMaps) -> CandidateHits:
     """What full-resolution pixels see without the object, among the triangles their nearest
     working pixel's 3 x 3 neighbourhood sees without it."""
-    w, h = maps.width, maps.height
-    ny, nx = np.divmod(nearest, w)
-    offsets = [(dy, dx) for dy in (-1, 0, 1) for dx in (-1, 0, 1)]
-    candidates = np.stack([maps.tri_without[np.clip(ny + dy, 0, h - 1) * w + np.mod(nx + dx, w)]
-                           for dy, dx in offsets], axis=1)
+    candidates = maps.candidates[nearest]
     # Most pixels' neighbourhoods see one triangle: those test just it.
-    uniform = (candidates == candidates[:, :1]).all(axis=1)
+    uniform = candidates[:, 1] < 0 if candidates.shape[1] > 1 else np.ones(len(nearest), dtype=bool)
     if uniform.all() or not uniform.any():
         return hits_among(directions, geo.triangles, candidates[:, :1] if uniform.all() else candidates)
     one = hits_among(directions[uniform], geo.triangles, candidates[uniform, :1])

@@ -4,7 +4,7 @@ panorama around it, with the artist's mask applied.
 A proxy placed by eye is a few centimetres, degrees and percent off. The region the removal
 fills is therefore decided by the image in a band around the proxy's silhouette; the proxy
 alone decides farther away. The window is segmented at the panorama's own resolution, or on
-an area-averaged copy when it would exceed `_MAX_PIXELS` (a close object in a 16K panorama).
+an area-averaged copy when it would exceed `max_pixels` (a close object in a 16K panorama).
 """
 from __future__ import annotations
 
@@ -25,7 +25,7 @@ from .grabcut import ObjectSegmentation, segment_object
 from .masks import blur, box_mean, dilate
 from .user_mask import UserMask
 
-_MAX_PIXELS = 1 << 20  # the largest window segmented at full resolution
+MAX_PIXELS = 1 << 20  # the largest window segmented at full resolution (the default)
 _COARSE_WIDTH = 512  # the panorama's width at which the window is first found
 _PAD = 2  # pixels the window reaches past the band
 _MIN_BAND = 3
@@ -101,11 +101,13 @@ class SeenObject:
 
 
 def seen_object(hdri: np.ndarray, geo: Geometry, index: int, *, segment: bool = True, band: float = 0.12,
-                mask: UserMask | None = None, rep: Report | None = None) -> SeenObject | None:
+                max_pixels: int = MAX_PIXELS, mask: UserMask | None = None, rep: Report | None = None
+                ) -> SeenObject | None:
     """The object `index` of `geo` (probe frame) as the panorama `hdri` (H, W, 3) shows it; None
     when no pixel sees it (nor does the user's mask add any). `band` is the half-width of
     the band the image decides, as a share of the object's angular size. DimredError when the
-    proxy does not lie over anything the photograph shows as an object there."""
+    proxy does not lie over anything the photograph shows as an object there. A window larger
+    than `max_pixels` is segmented on a copy averaged over 2 x 2 pixels (4 x 4, ...)."""
     height, width = hdri.shape[:2]
     on = geo.tri_object == index
     projection = geo.projection  # before the two threads below, so it is worked out once
@@ -118,7 +120,7 @@ def seen_object(hdri: np.ndarray, geo: Geometry, index: int, *, segment: bool = 
     distance = float(np.linalg.norm(mid))
     angular = 2.0 * np.arcsin(min(1.0, radius / max(distance, 1e-12)))
     band_full = max(_MIN_BAND, int(np.ceil(band * angular * height / np.pi)))
-    factor = _factor(spot, band_full, width, height)
+    factor = _factor(spot, band_full, width, height, max_pixels)
     hs, ws = height // factor, width // factor
     band_px = max(_MIN_BAND, int(np.ceil(band_full / factor)))
     frame, shape = _window(spot, band_px + _PAD, hs, ws)
@@ -185,7 +187,7 @@ def _scattered(mask: np.ndarray, height: int, width: int) -> np.ndarray:
     return out
 
 
-def _factor(spot: np.ndarray, band: int, width: int, height: int) -> int:
+def _factor(spot: np.ndarray, band: int, width: int, height: int, max_pixels: int) -> int:
     """Panorama pixels per segmentation pixel: 1 unless the window would be too large (then a
     power of two that divides the panorama's size)."""
     r0, r1, _, cols = pixel_span(spot, 1)
@@ -193,7 +195,7 @@ def _factor(spot: np.ndarray, band: int, width: int, height: int) -> int:
     pixels = (r1 - r0) * scale + 2 * band
     pixels *= cols * scale + 2 * band
     factor = 1
-    while pixels / factor**2 > _MAX_PIXELS and width % (2 * factor) == 0 and height % (2 * factor) == 0:
+    while pixels / factor**2 > max_pixels and width % (2 * factor) == 0 and height % (2 * factor) == 0:
         factor *= 2
     return factor
 
