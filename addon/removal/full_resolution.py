@@ -43,7 +43,7 @@ from .refine_samples import refine_samples, sample_stride
 from .relit_noise import relit_noise_stage
 from .seam import seamless_block_change
 from .solution import Solution
-from .working_maps import Cells, WorkingMaps, cells, neighbours, surfaces_seen, working_maps
+from .working_maps import Cells, WorkingMaps, cells, nearest_working, neighbours, surfaces_seen, working_maps
 
 _BAND_PIXELS = 1 << 19  # full-resolution pixels per band (arrays of a few MB: reused, not mapped anew)
 _SHARP = 0.1  # neighbours whose dE / E differ by more than this leave the pixel to be refined
@@ -309,8 +309,8 @@ class _BandPixels:
         if not len(index):
             return
         r, c = rows[0] + index // width, index % width
-        near = neighbours(r, c, (height, width), maps)
-        found = surfaces_seen(latlong.pixel_directions_at(r, c, width, height), near.nearest, solution.geo, maps)
+        found = surfaces_seen(latlong.pixel_directions_at(r, c, width, height),
+                              nearest_working(r, c, (height, width), maps), solution.geo, maps)
         self.tri[index], self.bary[index], self.distance[index] = found.tri, found.bary, found.distance
         self.own[index] = surfaces_of(self.keys, found.tri)
         self.known[index] = True

@@ -14,7 +14,7 @@ from ..geometry.span import pixel_span
 from ..segmentation.seen import SeenObject
 from ..side_by_side import each
 from .target import Target
-from .working_maps import WorkingMaps, neighbours, surfaces_seen
+from .working_maps import WorkingMaps, nearest_working, surfaces_seen
 
 _PAD = 4  # working pixels the window reaches past what it must hold
 _MAX_PIXELS = 2 << 20  # the largest window (its arrays and the fill's maps take ~120 bytes a pixel)
@@ -89,8 +89,8 @@ def object_window(geo: Geometry, target: Target, hidden_working: np.ndarray, cov
     def look_up(start: int) -> None:
         """What the block of rows from `start` sees, written into its rows."""
         rows_b = row_start + np.arange(start, min(start + block, shape[0]))
-        near = neighbours(np.repeat(rows_b, ncols), np.tile(cols_full, len(rows_b)), full, maps)
-        found = surfaces_seen(directions[start:start + len(rows_b)].reshape(-1, 3), near.nearest, geo, maps)
+        nearest = nearest_working(rows_b[:, None], cols_full[None, :], full, maps).ravel()
+        found = surfaces_seen(directions[start:start + len(rows_b)].reshape(-1, 3), nearest, geo, maps)
         tri[start:start + len(rows_b)] = found.tri.reshape(-1, ncols)
         distance[start:start + len(rows_b)] = found.distance.reshape(-1, ncols)
         bary[start:start + len(rows_b)] = found.bary.reshape(-1, ncols, 2)

@@ -96,19 +96,24 @@ def cells(maps: WorkingMaps) -> Cells:
 @dataclass(frozen=True)
 class Neighbours:
     """For full-resolution pixels: the flat indices (4, N) of their four bilinear working
-    neighbours and the weights (4, N), and the nearest working pixel (N,)."""
+    neighbours and the weights (4, N)."""
 
     index: np.ndarray
     weight: np.ndarray
-    nearest: np.ndarray
+
+
+def _working_coordinates(rows: np.ndarray, cols: np.ndarray, full: tuple[int, int], maps: WorkingMaps
+                         ) -> tuple[np.ndarray, np.ndarray]:
+    """The continuous working row and column of full-resolution pixels (rows, cols) of a
+    (height, width) panorama (0 at a working pixel's centre)."""
+    height, width = full
+    return (rows + 0.5) * (maps.height / height) - 0.5, (cols + 0.5) * (maps.width / width) - 0.5
 
 
 def neighbours(rows: np.ndarray, cols: np.ndarray, full: tuple[int, int], maps: WorkingMaps) -> Neighbours:
     """The working neighbours of full-resolution pixels (rows, cols) of a (height, width)
     panorama; they wrap around the seam and clamp at the poles."""
-    height, width = full
-    y = (rows + 0.5) * (maps.height / height) - 0.5
-    x = (cols + 0.5) * (maps.width / width) - 0.5
+    y, x = _working_coordinates(rows, cols, full, maps)
     y0, x0 = np.floor(y), np.floor(x)
     fy, fx = y - y0, x - x0
     ya = np.clip(y0.astype(np.int64), 0, maps.height - 1)
@@ -117,9 +122,16 @@ def neighbours(rows: np.ndarray, cols: np.ndarray, full: tuple[int, int], maps: 
     xb = np.mod(x0.astype(np.int64) + 1, maps.width)
     index = np.stack([ya * maps.width + xa, ya * maps.width + xb, yb * maps.width + xa, yb * maps.width + xb])
     weight = np.stack([(1 - fy) * (1 - fx), (1 - fy) * fx, fy * (1 - fx), fy * fx])
+    return Neighbours(index, weight)
+
+
+def nearest_working(rows: np.ndarray, cols: np.ndarray, full: tuple[int, int], maps: WorkingMaps) -> np.ndarray:
+    """The flat index of the working pixel nearest to each full-resolution pixel (rows, cols),
+    which broadcast against each other (a block's rows down, its columns across)."""
+    y, x = _working_coordinates(rows, cols, full, maps)
     ny = np.clip(np.round(y).astype(np.int64), 0, maps.height - 1)
     nx = np.mod(np.round(x).astype(np.int64), maps.width)
-    return Neighbours(index, weight, ny * maps.width + nx)
+    return ny * maps.width + nx
 
 
 def surfaces_seen(directions: np.ndarray, nearest: np.ndarray, geo: Geometry, maps: WorkingMaps) -> CandidateHits:
