@@ -48,11 +48,10 @@ class Revealed:
 
 @dataclass(frozen=True)
 class HiddenLight:
-    """The revealed pixels' light once the object is gone, and what they show before any
-    texture: their patches' mean reflectance, or the radiosity of a light behind the object."""
+    """The revealed pixels' light once the object is gone, and the radiosity of a light
+    behind the object that they see."""
 
     e_after: np.ndarray  # (K, 3) irradiance after the removal
-    rho: np.ndarray  # (K, 3) their patches' mean reflectance
     emit: np.ndarray  # (K,) bool: the pixel sees a light
     emitted: np.ndarray  # (K, 3) that light's radiance (its patch's radiosity / pi)
 
@@ -65,7 +64,7 @@ class HiddenLight:
 
 def hidden_light(solution: Solution, revealed: Revealed, callbacks: RunCallbacks) -> HiddenLight:
     """The irradiance after the removal at the revealed pixels (light transport: the report's
-    stage `hidden_light`, apart from the synthesis that `fill_hidden` adds to it)."""
+    stage `hidden_light`, apart from the synthesis of `filled_reflectance`)."""
     room = solution.room
     e_after = light_after(solution.lit, revealed.tri, revealed.bary, callbacks)
     patch, _, _ = room.patches.lattice.locate(revealed.tri, revealed.bary)
@@ -73,8 +72,7 @@ def hidden_light(solution: Solution, revealed: Revealed, callbacks: RunCallbacks
     emitted = np.zeros((len(patch), 3))
     # A light behind the object shines on with the radiosity its patch was given.
     emitted[emit] = room.senders.radiosity[patch[emit]] / np.pi
-    return HiddenLight(e_after=np.maximum(e_after, 0.0),
-                       rho=room.rho[patch], emit=emit, emitted=emitted)
+    return HiddenLight(e_after=np.maximum(e_after, 0.0), emit=emit, emitted=emitted)
 
 
 def fill_hidden(solution: Solution, revealed: Revealed, light: HiddenLight, rep: Report, callbacks: RunCallbacks,
@@ -85,14 +83,21 @@ def fill_hidden(solution: Solution, revealed: Revealed, light: HiddenLight, rep:
     `show(change)` gets the revealed pixels' change as the fill refines: first with each
     patch's mean reflectance, then after every synthesis level of every surface and with each
     surface's final fill."""
+    shown = None if show is None else (lambda rho: show(light.change(rho, revealed.radiance)))
+    return light.change(filled_reflectance(solution, revealed, rep, callbacks, show=shown), revealed.radiance)
+
+
+def filled_reflectance(solution: Solution, revealed: Revealed, rep: Report, callbacks: RunCallbacks, *,
+                       show: Callable[[np.ndarray], None] | None = None) -> np.ndarray:
+    """(K, 3) the reflectance of the revealed pixels, synthesised surface by surface (each
+    patch's mean reflectance where a surface is too little seen). It needs no light, so a
+    full-resolution removal computes the light after the removal meanwhile. `show(rho)` gets
+    it as `fill_hidden`'s `show` says."""
     geo = solution.geo
-    rho = light.rho.copy()
-
-    def change() -> np.ndarray:
-        return light.change(rho, revealed.radiance)
-
+    patch, _, _ = solution.room.patches.lattice.locate(revealed.tri, revealed.bary)
+    rho = solution.room.rho[patch].copy()
     if show is not None:
-        show(change())
+        show(rho)
     options = FillOptions(cell=float(np.median(revealed.footprint)) * solution.params.raster_cell,
                           margin=solution.params.exemplar_margin,
                           synthesis=SynthesisParams(neighbourhood=solution.params.synth_neighbourhood,
@@ -108,7 +113,7 @@ def fill_hidden(solution: Solution, revealed: Revealed, light: HiddenLight, rep:
 
         def level_shown(level_rho: np.ndarray) -> None:
             rho[sel] = level_rho
-            show(change())
+            show(rho)
 
         t0 = time.perf_counter()
         got = fill_surface(revealed.panorama, plane, options, cancel=callbacks.cancel,
@@ -125,7 +130,7 @@ def fill_hidden(solution: Solution, revealed: Revealed, light: HiddenLight, rep:
         if got.known_cells:
             rho[sel] = got.rho
             if show is not None:  # with the photograph's fine detail, which the levels do not show
-                show(change())
+                show(rho)
         if not got.synthesised:
             rep.warn(f"too little of '{name}' is seen around the object to synthesise its texture: "
                      f"{len(sel)} pixels get its mean reflectance")
@@ -141,7 +146,7 @@ def fill_hidden(solution: Solution, revealed: Revealed, light: HiddenLight, rep:
         names = {int(k): geo.object_names[geo.tri_object[t]] for k, t in zip(*np.unique(solution.target.surface_key,
                                                                                        return_index=True), strict=True)}
         rep.info["surface_edges"] = [edge.describe(names) for edge in revealed.edges.edges]
-    return change()
+    return rho
 
 
 def _material_warning(surface: str, material: Material) -> str:
