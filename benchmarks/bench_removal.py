@@ -50,8 +50,8 @@ def main() -> None:
                   title=f"scene {args.scene} {args.width}x{args.width // 2} @ {args.samples} spp; "
                         f"read_scene {read_s:.2f} s; noise floor {floor:.3f}")
     for preset, sec, ratio, hidden in rows:
-        table.row(preset, *(f"{sec[k]:.2f}" if k in sec else "-" for k in stages), f"{sec['total']:.2f}", f"{ratio:.3f}",
-                  f"{hidden['mean_ratio']:.3f}", f"{hidden['detail_ratio']:.2f}",
+        table.row(preset, *(f"{sec[k]:.2f}" if k in sec else "-" for k in stages), f"{sec['total']:.2f}",
+                  f"{ratio:.3f}", f"{hidden['mean_ratio']:.3f}", f"{hidden['detail_ratio']:.2f}",
                   f"{hidden['object_shadow_ratio']:.3f}")
     write(table)
 
