@@ -37,25 +37,16 @@ _AROUND = (0.75, 0.625, 0.5)  # shares of the counted directions a colour must b
 _RING_MATCH = 0.5  # the share of the ring's outer half that must match for a stricter share to hold
 _MIN_BEYOND = 0.01  # share of the seen cells thin things of no material colour must make to be left out
 _SCATTER_RADIUS = 3  # cells: most of the known cells this near an exemplar cell must be exemplar too
-# A rug's fine pattern, averaged over the 3x3 cells a colour is told by, passes for the floor's
-# colour: a patch (wider than a tile's edge or a plank's seam, 5x5 cells) whose cells' detail is
-# this many times the material's typical detail is another thing. On the hotel photograph's floor
-# the material's cells deviate by 0.05-0.07 (log luminance, from their 3x3 mean) at the median,
-# its rug's patterned strip by 0.25-0.5.
-_BUSY = 4.0
-_BUSY_WIDTH = 2
 _MIN_SHARE_WARN = 0.5  # below this share of the seen cells, the surface is mostly something else
 
 
 @dataclass(frozen=True)
 class Material:
-    """The known cells of the hole's material (`exemplar`), the known cells of something else
-    wider than a line (`other`: a rug, a foot, the object's legs), those of them beside the hole
+    """The known cells of the hole's material (`exemplar`), the other known cells near the hole
     that the fill repaints as context (`replaced`), and what the exemplar is: `source`
     'border material' or, where too few cells match, 'whole surface'."""
 
     exemplar: np.ndarray
-    other: np.ndarray
     replaced: np.ndarray
     source: str
     share: float  # exemplar cells / known cells
@@ -68,13 +59,10 @@ class Material:
         return self.decided and (self.source != "border material" or self.share < _MIN_SHARE_WARN)
 
 
-def border_material(image: np.ndarray, known: np.ndarray, hole: np.ndarray, *, min_cells: int, context: int
-                    ) -> Material:
+def border_material(image: np.ndarray, known: np.ndarray, hole: np.ndarray, *, min_cells: int) -> Material:
     """The cells of `image` (h, w, 3 reflectance) among `known` whose material surrounds `hole`;
-    the whole of `known` where fewer than `min_cells` match. What is of another material within
-    `context` cells of the hole (as far as the fill's window reaches) is to be repainted."""
-    undecided = Material(exemplar=known, other=np.zeros_like(known), replaced=np.zeros_like(known),
-                         source="whole surface", share=1.0,
+    the whole of `known` where fewer than `min_cells` match."""
+    undecided = Material(exemplar=known, replaced=np.zeros_like(known), source="whole surface", share=1.0,
                          decided=False)
     if not hole.any():
         return undecided
@@ -128,7 +116,6 @@ def border_material(image: np.ndarray, known: np.ndarray, hole: np.ndarray, *, m
         # the planks' structure draws between their visible ends
         beyond[:] = False
     wide = dilate(dilate(erode(known & ~matching, 1), 1), 1) & known
-    wide |= _busy(log_y, known, matching & around, centre)  # of the floor's colours, but patterned: a rug
     exemplar = known & ~wide & ~(dilate(beyond, 1) & known)
     # and not scattered in something else (a rug's stripes whose blends pass for wood)
     nearby, _ = box_mean(exemplar[..., None].astype(np.float64), known, _SCATTER_RADIUS)
@@ -136,40 +123,8 @@ def border_material(image: np.ndarray, known: np.ndarray, hole: np.ndarray, *, m
     if exemplar.sum() < min_cells:
         return replace(undecided, decided=True)
     # Only what is wider than a line is repainted beside the hole: a thin stripe is only left out.
-    # And only as far as the fill reads from the hole: everything else not of the material is just
-    # left out of its distances, and the real surroundings farther out stay its context. Repainted
-    # out to the ring's reach (up to 32 cells), a painted floor's other half beside the hole was
-    # composed anew around it and a lane's crossing line copied into the hole (workshop_box at
-    # 512x256: total 0.514, 0.321 repainted within the 7-cell window's reach; hotel_box's fill mean
-    # error 0.120, 0.080; no photo-textured scene's total worse by more than 0.018).
-    return Material(exemplar=exemplar, other=wide, replaced=dilate(hole, context) & ~hole & wide,
-                    source="border material", share=float(exemplar.sum() / known.sum()))
-
-
-def _busy(log_y: np.ndarray, known: np.ndarray, material: np.ndarray, centre: tuple[float, float]) -> np.ndarray:
-    """(h, w) the known cells in a patch (wider than a tile's edge or a seam) whose fine detail (the
-    mean absolute deviation of `log_y` from its 3x3 mean, over 3x3 cells) is `_BUSY` times the
-    median of the `material`'s cells, with a cell of margin; none where such patches lie among the
-    material's cells in as many directions around `centre` as its colours must (a plank floor's
-    crossing seams, a tiling's corners: the material's own texture)."""
-    mean, _ = box_mean(log_y[..., None], known, 1)
-    level, _ = box_mean(np.abs(log_y - mean[..., 0])[..., None], known, 1)
-    busy = known & (level[..., 0] > _BUSY * np.median(level[..., 0][material]))
-    busy = dilate(dilate(erode(busy, _BUSY_WIDTH), _BUSY_WIDTH), 1) & known
-    rows, cols, sector = _sectors(material, centre)
-    cells = np.bincount(sector, minlength=_SECTORS)
-    found = np.bincount(sector[busy[rows, cols]], minlength=_SECTORS) >= np.maximum(_PRESENT * cells, 2.0)
-    counted = cells >= _MIN_SECTOR_CELLS
-    if counted.any() and (found & counted).sum() >= _AROUND[0] * counted.sum():
-        return np.zeros_like(busy)
-    return busy
-
-
-def _sectors(cells: np.ndarray, centre: tuple[float, float]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The (row, column) of the `cells` set and the direction (of `_SECTORS`) each lies in around `centre`."""
-    rows, cols = np.nonzero(cells)
-    sector = ((np.arctan2(rows - centre[0], cols - centre[1]) + np.pi) / (2 * np.pi) * _SECTORS).astype(np.int64)
-    return rows, cols, sector % _SECTORS
+    return Material(exemplar=exemplar, replaced=near & wide, source="border material",
+                    share=float(exemplar.sum() / known.sum()))
 
 
 def _directions(flat: np.ndarray, shape: tuple[int, ...], ring: np.ndarray, centre: tuple[float, float]
@@ -177,9 +132,10 @@ def _directions(flat: np.ndarray, shape: tuple[int, ...], ring: np.ndarray, cent
     """(h, w) per cell, the share of the directions around `centre` (those with cells enough of
     `ring`) in which its colour (bin `flat` (h, w) of a grid of `shape`) is present in `ring`;
     None where the ring covers too few directions or cells to tell a material apart."""
-    rows, cols, sector = _sectors(ring, centre)
+    rows, cols = np.nonzero(ring)
+    sector = ((np.arctan2(rows - centre[0], cols - centre[1]) + np.pi) / (2 * np.pi) * _SECTORS).astype(np.int64)
     counts = np.zeros((int(np.prod(shape)), _SECTORS))
-    np.add.at(counts, (flat[rows, cols], sector), 1.0)
+    np.add.at(counts, (flat[rows, cols], sector % _SECTORS), 1.0)
     per_sector = counts.sum(axis=0)
     counted = per_sector >= _MIN_SECTOR_CELLS
     if counted.sum() < _MIN_SECTORS or per_sector.sum() < _MIN_RING_CELLS:

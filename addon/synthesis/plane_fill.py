@@ -140,11 +140,9 @@ def fill_surface(
             hole[np.clip(r + dr, 0, h - 1), np.clip(c + dc, 0, w - 1)] = True
     hole |= flags == planeraster.HIDDEN
     hole &= ~known
-    material = border_material(values, known, hole, min_cells=_MIN_KNOWN,
-                               context=options.synthesis.neighbourhood // 2)
+    material = border_material(values, known, hole, min_cells=_MIN_KNOWN)
     # Only the hole's own material is copied; other things seen beside the hole (the object's
-    # legs, a rug's edge) are repainted as far as the synthesis's window reaches from the hole,
-    # so that nothing continues them into it.
+    # legs, a rug's edge) are repainted as context so that nothing continues them into it.
     exemplar, to_fill = material.exemplar, hole | material.replaced
     mean = values[exemplar].mean(axis=0) if exemplar.any() else np.zeros(3)
     image = np.where(exemplar[..., None], values, mean)
@@ -161,7 +159,7 @@ def fill_surface(
     if filled is None:
         rho = planeraster.sample_raster(raster, image, points)
     else:
-        rho = _filled_rho(filled, panorama, plane, raster, image, exemplar, material.other)
+        rho = _filled_rho(filled, panorama, plane, raster, image, exemplar)
     structure = None if filled is None else filled.structure
     return SurfaceFill(rho=rho, raster_shape=raster.shape, cell=raster.cell, known_cells=int(known.sum()),
                        hole_cells=int(to_fill.sum()), synthesised=filled is not None,
@@ -177,17 +175,16 @@ def _sharpened_lines(filled: Filled) -> np.ndarray:
 
 
 def _filled_rho(filled: Filled, panorama: PanoramaReflectance, plane: HiddenPlane, raster: planeraster.PlaneRaster,
-                image: np.ndarray, known: np.ndarray, other: np.ndarray) -> np.ndarray:
+                image: np.ndarray, known: np.ndarray) -> np.ndarray:
     """(N, 3) the filled raster at the plane's hidden points, with the photograph's detail finer
     than the raster (`_with_photograph_detail`). On planks, the lines interpolated along them
-    take the planks' profile across them (`plank_profile`, from the pixels not on `other` cells:
-    things of another material) where one is found; where none is, they are sharpened across
-    instead and the copies' grain weighs more."""
+    take the planks' profile across them (`plank_profile`) where one is found; where none is,
+    they are sharpened across instead and the copies' grain weighs more."""
     structure = filled.structure
     profile, across = None, None
     if structure is not None and structure.lines is not None:
         across = _along(raster, 1 - structure.along)
-        profile = _plank_profile(panorama, plane, raster, image, known, other, structure.along)
+        profile = _plank_profile(panorama, plane, raster, image, known, structure.along)
     if profile is None:
         rho = planeraster.sample_raster(raster, _sharpened_lines(filled), plane.points)
         weight = 1.0 if structure is None else structure.detail
@@ -207,11 +204,10 @@ def _nearest_cells(raster: planeraster.PlaneRaster, points: np.ndarray) -> tuple
 
 
 def _plank_profile(panorama: PanoramaReflectance, plane: HiddenPlane, raster: planeraster.PlaneRaster,
-                   image: np.ndarray, known: np.ndarray, other: np.ndarray, along: int) -> PlankProfile | None:
+                   image: np.ndarray, known: np.ndarray, along: int) -> PlankProfile | None:
     """The profile across the planks (which run along raster axis `along`) of the plane's pixels
-    seen on the raster, but on `other` cells: each pixel's reflectance over the raster's mean of
-    the `known` cells around it (its own fine detail, free of the light and of the planks'
-    shades), folded over the planks' width."""
+    seen on the raster: each pixel's reflectance over the raster's mean around it (its own fine
+    detail, free of the light and of the planks' shades), folded over the planks' width."""
     maps = panorama.maps
     seen = panorama.shows(plane.surface)
     rows, cols = np.nonzero(seen)
@@ -228,10 +224,7 @@ def _plank_profile(panorama: PanoramaReflectance, plane: HiddenPlane, raster: pl
     mean, _ = box_mean((image @ LUMA)[..., None], known, _PROFILE_MEAN_RADIUS)
     local = planeraster.sample_raster(raster, mean, points[inside])[:, 0]
     value = panorama.rho[rows[inside], cols[inside]] @ LUMA
-    # Not on another thing (a rug, a busy streak): the demo's floor, a cross of 1-px streaks far
-    # from the hole left out as busy (`material._busy`), had them folded into the profile as white
-    # specks (detail ratio 5.2). Thin seams the exemplar leaves out stay: they are the profile.
-    ok = (local > 1e-6 * max(float(local.max(initial=0.0)), 1e-30)) & ~other[_nearest_cells(raster, points[inside])]
+    ok = local > 1e-6 * max(float(local.max(initial=0.0)), 1e-30)
     seen_points = points[inside][ok]
     return fold_profile(seen_points @ _along(raster, 1 - along), seen_points @ _along(raster, along),
                         value[ok] / local[ok], min_width=4 * raster.cell)

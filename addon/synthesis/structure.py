@@ -26,9 +26,6 @@ from .translations import DOMINANT, Translations, dominant_translations, relativ
 _TRANSLATIONS = 8  # of the texture's repeats, the best this many are labels (time grows with labels^2)
 _SHORT_SHIFTS = (2, 4, 8)  # cells: what a plank changes by along its length and across it
 _PLANK_ANISOTROPY = 0.8  # planks: the texture changes along one axis at most this share of across it
-_DIRECTIONS = 8  # directions a plank axis is compared with (every 22.5 degrees)
-_SLANT_STEPS = 2  # of _SHORT_SHIFTS, those a slant is told by
-_SLANT = 0.8
 _LINE_ENDS = 6  # cells averaged at each visible end of a line along the planks (3: -0.02-0.07 in structure)
 # The copies' detail finer than the raster, on planks whose profile is not found, over the lines
 # sharpened where they are looked up (`plane_fill._LINE_SHARPENING`; with the profile,
@@ -149,18 +146,10 @@ def _plank_axis(image: np.ndarray, known: np.ndarray, hole: np.ndarray) -> int |
     floors, 0.97-1.03 on four checkers. The known pixels compared lie within the hole's extent
     of it: a narrower ring can miss a tiling's grout lines along one axis altogether."""
     steps = np.array(_SHORT_SHIFTS)
-    angles = np.arange(_DIRECTIONS) * np.pi / _DIRECTIONS  # 0: along axis 0, pi/2: along axis 1
-    shifts = np.rint(np.stack([np.cos(angles)[:, None] * steps, np.sin(angles)[:, None] * steps], axis=-1)
-                     ).astype(np.int64).reshape(-1, 2)
-    score = relative_difference(image, known, hole, shifts, ring=hole_extent(hole)).reshape(_DIRECTIONS, len(steps))
-    rows, columns = float(score[0].sum()), float(score[_DIRECTIONS // 2].sum())
+    shifts = np.concatenate([np.stack([steps, 0 * steps], axis=1), np.stack([0 * steps, steps], axis=1)])
+    score = relative_difference(image, known, hole, shifts, ring=hole_extent(hole))
+    rows, columns = float(score[:len(steps)].sum()), float(score[len(steps):].sum())
     if not np.isfinite(rows + columns) or min(rows, columns) > _PLANK_ANISOTROPY * max(rows, columns):
-        return None
-    # A line across the floor at a slant (a painted lane) changes least along its own direction:
-    # no plank, and interpolated along an axis it comes out as stripes. Told by the steps shorter
-    # than a plank's width (a longer one across planks can meet their period and match as well).
-    short = score[:, :_SLANT_STEPS].sum(axis=1)
-    if np.nanmin(short) < _SLANT * min(short[0], short[_DIRECTIONS // 2]):
         return None
     return 0 if rows < columns else 1
 

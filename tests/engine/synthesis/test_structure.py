@@ -47,16 +47,6 @@ def _noise(size=160, seed=0):
     return (0.5 + 0.08 * smooth * np.array([1.0, 0.9, 0.8])).astype(np.float32)
 
 
-def _slanted_lane(size=160, seed=0):
-    """A painted lane 6 cells wide across a noisy floor at 26 degrees to the raster's axes, as a
-    warehouse's floor marking runs across a room whose walls the raster follows: anisotropic like
-    planks, but changing least along its own slant."""
-    y, x = np.mgrid[:size, :size]
-    lane = np.abs((y - 80) * np.cos(np.radians(26)) - (x - 80) * np.sin(np.radians(26))) < 3
-    img = np.where(lane[..., None], np.array([0.6, 0.5, 0.05]), np.array([0.25, 0.3, 0.12]))
-    return (img * (1 + 0.05 * np.random.default_rng(seed).standard_normal((size, size, 1)))).astype(np.float32)
-
-
 def _hole(size, lo, hi):
     m = np.zeros((size, size), bool)
     m[lo:hi, lo + 5:hi + 9] = True
@@ -236,8 +226,7 @@ def test_a_tilings_labels_combine_its_repeats_only():
     assert {tuple(x) for x in got.shifts.shifts} <= combined
 
 
-@pytest.mark.parametrize("texture, along", [(_planks, 1), (_grain_planks, 1), (_tiles, None), (_noise, None),
-                                            (_slanted_lane, None)])
+@pytest.mark.parametrize("texture, along", [(_planks, 1), (_grain_planks, 1), (_tiles, None), (_noise, None)])
 def test_the_planks_axis_is_found_whichever_raster_axis_they_follow(texture, along):
     img = texture()
     hole = _hole(160, 55, 105)
