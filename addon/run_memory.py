@@ -27,6 +27,7 @@ from __future__ import annotations
 import ctypes
 import importlib
 import sys
+import threading
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 
@@ -67,22 +68,43 @@ def _glibc() -> ctypes.CDLL | None:
     return libc
 
 
+class _Held:
+    """The runs inside `run_memory` now (the command line's around the pipeline's, the add-on's
+    job beside a script's) and the huge-page advice the first of them found: the settings are
+    the process's, so the first run in sets them and the last one out puts them back."""
+
+    def __init__(self) -> None:
+        self.lock = threading.Lock()
+        self.runs = 0
+        self.advice: bool | None = None
+
+
+_HELD = _Held()
+
+
 @contextmanager
 def run_memory() -> Iterator[None]:
     """Run the body with numpy's huge-page advice off and glibc's malloc keeping freed memory;
-    afterwards put the advice back and give the memory kept to the system."""
+    afterwards put the advice back and give the memory kept to the system. Nested and
+    concurrent runs share the settings until the last of them ends."""
     setter, libc = _advice_setter(), _glibc()
-    advice = setter(False) if setter is not None else None
-    if libc is not None:
-        libc.mallopt(_M_TRIM_THRESHOLD, _KEPT_BYTES)
-        libc.mallopt(_M_MMAP_THRESHOLD, _OWN_MAPPING_BYTES)
-        libc.mallopt(_M_ARENA_MAX, 1)
+    with _HELD.lock:
+        _HELD.runs += 1
+        if _HELD.runs == 1:
+            _HELD.advice = setter(False) if setter is not None else None
+            if libc is not None:
+                libc.mallopt(_M_TRIM_THRESHOLD, _KEPT_BYTES)
+                libc.mallopt(_M_MMAP_THRESHOLD, _OWN_MAPPING_BYTES)
+                libc.mallopt(_M_ARENA_MAX, 1)
     try:
         yield
     finally:
-        if setter is not None:
-            setter(advice)
-        if libc is not None:
-            libc.mallopt(_M_TRIM_THRESHOLD, _DEFAULT_TRIM_BYTES)
-            libc.mallopt(_M_ARENA_MAX, _DEFAULT_ARENAS)
-            libc.malloc_trim(0)
+        with _HELD.lock:
+            _HELD.runs -= 1
+            if _HELD.runs == 0:
+                if setter is not None:
+                    setter(_HELD.advice)
+                if libc is not None:
+                    libc.mallopt(_M_TRIM_THRESHOLD, _DEFAULT_TRIM_BYTES)
+                    libc.mallopt(_M_ARENA_MAX, _DEFAULT_ARENAS)
+                    libc.malloc_trim(0)

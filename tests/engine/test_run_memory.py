@@ -68,3 +68,24 @@ def test_glibc_is_found_here_when_the_platform_has_it() -> None:
     if libc is None:
         pytest.skip("not glibc")
     assert isinstance(libc, ctypes.CDLL)
+
+
+def test_nested_and_overlapping_runs_share_the_settings_until_the_last_ends(monkeypatch) -> None:
+    libc = _Libc()
+    monkeypatch.setattr(memory_module, "_glibc", lambda: libc)
+    previous = multiarray._set_madvise_hugepage(True)
+    try:
+        outer = run_memory()
+        outer.__enter__()
+        with run_memory():  # the pipeline's inside the command line's
+            assert len(libc.calls) == 3 and multiarray._get_madvise_hugepage() is False
+        assert len(libc.calls) == 3 and multiarray._get_madvise_hugepage() is False
+        second = run_memory()  # another thread's, begun before the first ends
+        second.__enter__()
+        outer.__exit__(None, None, None)
+        assert len(libc.calls) == 3 and multiarray._get_madvise_hugepage() is False
+        second.__exit__(None, None, None)
+        assert libc.calls[3:] == [("mallopt", -1, 128 << 10), ("mallopt", -8, 0), ("malloc_trim", 0)]
+        assert multiarray._get_madvise_hugepage() is True
+    finally:
+        multiarray._set_madvise_hugepage(previous)
