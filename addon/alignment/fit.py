@@ -17,10 +17,10 @@ import numpy as np
 
 from ..errors import DimredError
 from ..geometry import latlong
-from ..geometry.mesh import build_geometry, to_probe_frame
+from ..geometry.mesh import to_probe_frame
 from ..geometry.raycast import trace_panorama
 from ..quality import Params
-from ..removal.target import object_index
+from ..removal.target import object_index, scene_geometry
 from ..scene import SceneData
 from ..segmentation.masks import dilate, erode
 from ..segmentation.seen import SeenObject, seen_object
@@ -119,7 +119,7 @@ def align_object(scene: SceneData, object_name: str, *, params: Params, fit_heig
     index = object_index(scene, object_name)
     if params.segmentation_band <= 0:
         raise DimredError("Align to Photo needs the segmentation: segmentation_band must be above 0")
-    geo = build_geometry(scene.triangles, scene.tri_object, scene.object_names, scene.center, scene.rotation)
+    geo = scene_geometry(scene)
     if not (geo.tri_object == index).any():
         raise DimredError(f"'{object_name}' has no faces to align")
     seen = seen_object(scene.hdri, geo, index, band=params.segmentation_band)
