@@ -86,7 +86,7 @@ PRESETS = {
     "draft": Params(patches=200, object_patches=40, sender_fraction=0.9, max_senders=12, sender_samples=2,
                     fine_cells=2.0, fine_pixels=8.0, reach=0.15, significance=0.03, patch_samples=1, aggregate_far=3.0,
                     max_bounces=4, bounce_tolerance=1e-2, refine_pixels=50_000, working_width=512,
-                    segmentation_pixels=1 << 18),
+                    segmentation_pixels=1 << 16),
     "balanced": Params(),
     # Balanced's patches, patch samples, neighbourhood and bounce tolerance: more of any of them
     # cost up to 3x and left the error against the ground-truth renders no lower on every scene

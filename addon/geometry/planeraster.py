@@ -11,9 +11,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..side_by_side import each
 from . import latlong
 
 SEEN, HIDDEN, OTHER = 0, 1, 2
+_GRAIN_POINTS = 1 << 15  # points looked up at a time by sample_points_keeping_grain
 
 
 @dataclass
@@ -178,6 +180,20 @@ def sample_points_keeping_grain(points: np.ndarray, image: np.ndarray, valid: np
     i.i.d. grain its own spread back while a smooth signal, equal to its local mean, is
     interpolated as before."""
     frame = frame or Frame.whole(image.shape)
+    flat = points.reshape(-1, 3)
+    # In chunks, side by side: the sixteen lookups and their sums over a chunk stay in a core's
+    # cache (250k points at 8K: 0.40 s at once, 0.20 s so).
+    parts = each(lambda start: _keeping_grain(flat[start:start + _GRAIN_POINTS], image, valid, frame),
+                 range(0, len(flat), _GRAIN_POINTS))
+    if not parts:
+        return np.zeros((*points.shape[:-1], image.shape[-1])), np.zeros(points.shape[:-1])
+    return (np.concatenate([p[0] for p in parts]).reshape(*points.shape[:-1], -1),
+            np.concatenate([p[1] for p in parts]).reshape(points.shape[:-1]))
+
+
+def _keeping_grain(points: np.ndarray, image: np.ndarray, valid: np.ndarray, frame: Frame
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """`sample_points_keeping_grain` at (N, 3) points."""
     y0, x0, fy, fx = _lookup_position(points, frame)
     # the 4 x 4 pixels around each point: its four taps and their 3 x 3 neighbourhoods
     value, known = {}, {}

@@ -19,7 +19,7 @@ from .working_maps import WorkingMaps, nearest_working, surfaces_seen
 _PAD = 4  # working pixels the window reaches past what it must hold
 _MAX_PIXELS = 2 << 20  # the largest window (its arrays and the fill's maps take ~120 bytes a pixel)
 _RING = 3  # full-resolution pixels beside the object always get their own light
-_BLOCK_PIXELS = 1 << 19  # pixels looked up at a time (bounds the candidates' temporaries)
+_BLOCK_PIXELS = 1 << 17  # pixels looked up at a time (bounds the candidates' temporaries)
 
 
 @dataclass(frozen=True)
