@@ -122,7 +122,9 @@ def align_object(scene: SceneData, object_name: str, *, params: Params, fit_heig
     geo = scene_geometry(scene)
     if not (geo.tri_object == index).any():
         raise DimredError(f"'{object_name}' has no faces to align")
-    seen = seen_object(scene.hdri, geo, index, band=params.segmentation_band)
+    # The preset's resolution, as the removal segments: a draft at 8K aligns to the outline its
+    # removal will fill, found on 4 x 4 averages.
+    seen = seen_object(scene.hdri, geo, index, band=params.segmentation_band, max_pixels=params.segmentation_pixels)
     if seen is None or not seen.proxy.any():
         raise DimredError(f"'{object_name}' is not visible from the probe centre: there is no outline to align to")
     if seen.segmentation is None:
