@@ -127,6 +127,21 @@ def test_lookup_keeping_grain_keeps_a_pixels_spread_where_bilinear_halves_it():
     assert abs(kept.mean() - 1.0) < 0.005
 
 
+
+def test_lookup_keeping_grain_is_the_same_in_chunks_of_any_size(monkeypatch):
+    # The points are looked up in chunks side by side: the chunks' answers are the whole's.
+    rng = np.random.default_rng(6)
+    image = 1.0 + 0.1 * rng.standard_normal((64, 128, 3))
+    valid = rng.random((64, 128)) > 0.1
+    pts = _points_between_pixels(128, 64, rng, 1000).reshape(10, 100, 3)
+    whole, w_whole = PR.sample_points_keeping_grain(pts, image, valid)
+    monkeypatch.setattr(PR, "_GRAIN_POINTS", 37)  # 28 chunks, the last one short
+    chunked, w_chunked = PR.sample_points_keeping_grain(pts, image, valid)
+    assert whole.shape == (10, 100, 3) and w_whole.shape == (10, 100)
+    assert np.array_equal(whole, chunked) and np.array_equal(w_whole, w_chunked)
+    empty, w_empty = PR.sample_points_keeping_grain(np.zeros((0, 3)), image, valid)
+    assert empty.shape == (0, 3) and w_empty.shape == (0,)
+
 def test_lookup_keeping_grain_interpolates_a_smooth_image_as_bilinear_does():
     rows, cols = np.mgrid[0:128, 0:256].astype(float)
     image = np.stack([0.5 + 0.01 * rows + 0.003 * cols, 0.2 + 0.002 * cols, np.full_like(rows, 0.7)], axis=-1)
