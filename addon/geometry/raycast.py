@@ -11,12 +11,14 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
+from ..side_by_side import each
 from . import latlong
 
 _BATCH_PIXELS = 1 << 20  # pixel tests at a time
 _WIDE = 4096  # a triangle's window of this many pixels is tested alone
 _MARGIN = 1e-3  # pixels a window reaches past a triangle's exact bounds (rounding)
 _PAIR_CHUNK = 40_000
+_PROJECT_TRIANGLES = 1 << 15  # triangles projected at a time
 
 
 @dataclass
@@ -65,6 +67,15 @@ def project(triangles: np.ndarray) -> Projection:
     and the longitude runs one way, over less than half the circle. So a triangle that holds
     no pole spans the longitudes between its corners, the circle less the largest gap between
     them, and a few corners cost what a sliver of a pixel does."""
+    # In chunks side by side: a chunk's (T, 3, 3) temporaries stay in a core's cache (a mesh of
+    # 200k triangles: 0.31 s at once, 0.13 s so).
+    parts = each(lambda start: _projected(triangles[start:start + _PROJECT_TRIANGLES]),
+                 range(0, max(len(triangles), 1), _PROJECT_TRIANGLES))
+    return Projection(*(np.concatenate([getattr(p, f.name) for p in parts]) for f in fields(Projection)))
+
+
+def _projected(triangles: np.ndarray) -> Projection:
+    """`project` of the triangles (T, 3, 3) at once."""
     n = len(triangles)
     det = np.einsum("ij,ij->i", triangles[:, 0], np.cross(triangles[:, 1], triangles[:, 2]))
     scale = np.linalg.norm(triangles, axis=2).max(axis=1) ** 3

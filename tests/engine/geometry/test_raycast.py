@@ -92,3 +92,19 @@ def test_a_projection_taken_once_traces_every_subset_window_and_size_alike():
             np.testing.assert_array_equal(given.tri, alone.tri)
             np.testing.assert_array_equal(given.distance, alone.distance)
             np.testing.assert_array_equal(given.bary, alone.bary)
+
+
+def test_a_projection_in_chunks_of_any_size_is_the_whole_ones(monkeypatch):
+    from dataclasses import fields
+
+    from addon.geometry import raycast
+    from addon.geometry.patches import split_triangles
+
+    tris = np.concatenate([ROOM, split_triangles(box([-1.4, -0.3, -1.2], [-0.8, 0.3, -0.4]), 4).reshape(-1, 3, 3)])
+    whole = raycast.project(tris)
+    monkeypatch.setattr(raycast, "_PROJECT_TRIANGLES", 7)  # chunks of 7 triangles, the last one short
+    chunked = raycast.project(tris)
+    for f in fields(whole):
+        np.testing.assert_array_equal(getattr(chunked, f.name), getattr(whole, f.name))
+    none = raycast.project(np.zeros((0, 3, 3)))
+    assert none.edge_normals.shape == (0, 3, 3) and none.top.shape == (0,)
