@@ -41,10 +41,11 @@ FAILING: dict[tuple[str, str], str] = {
     # rug's stripes farther out are kept (the exemplar's mean 0.40, the border's 0.50).
     ("hotel_box", "total"): "measured 0.448",
     ("hotel_box", "mean_error"): "measured 0.181",
-    # The desk chair's dark foot copied into the floor behind the armchair-sized box, and the
-    # wall's fill (too little of its material seen to synthesise) at the mean of the door frame.
-    ("hotel_walls", "total"): "measured 0.722",
-    ("hotel_walls", "mean_error"): "measured 0.347",
+    # The wall's fill (too little of its material seen to synthesise) at the mean of the door
+    # frame. The desk's dark side, once copied into the floor behind the armchair-sized box
+    # (0.722 and 0.347), is now left out of the exemplar as far darker than the hole's border.
+    ("hotel_walls", "total"): "measured 0.589",
+    ("hotel_walls", "mean_error"): "measured 0.095",
     # The yellow floor line is continued into the hole with a branch the truth does not have.
     ("workshop_box", "total"): "measured 0.367",
 }

@@ -124,3 +124,36 @@ def test_clutter_filling_the_ring_beyond_a_band_of_the_material_is_left_out() ->
     assert (got.exemplar & wood).sum() > 0.8 * wood.sum()
     assert (got.exemplar & rug).sum() < 0.02 * rug.sum()
     assert not (got.exemplar & foot).any()
+
+
+def test_a_dark_desk_in_the_floors_hue_is_left_out_where_the_shares_relax() -> None:
+    """A hole against the wall on a floor whose printed light dims it toward a dark desk: the
+    wood's own shades are found in too few directions, the shares relax to half of them and the
+    desk's colour (the wood's hue, 8x darker) passes; it is far darker than the band right outside
+    the hole and not found all around it (the hotel photograph's desk at 256x128)."""
+    rng = np.random.default_rng(7)
+    rows, cols = np.indices((_H, _W))
+    image = _wood(rng) * np.exp(1.5 * (rows - 62) / 60.0)[..., None]
+    hole = _hole()
+    known = ~hole & (cols >= 52)
+    desk = np.zeros((_H, _W), bool)
+    desk[0:48, 52:150] = True
+    image[desk] *= 0.12 * (1 + 0.3 * rng.random((_H, _W, 1)))[desk]
+    got = border_material(image, known, hole, min_cells=64)
+    assert got.source == "border material"
+    assert not (got.exemplar & desk).any()
+    wood = known & ~desk
+    assert (got.exemplar & wood).sum() > 0.3 * wood.sum()
+
+
+def test_a_tilings_dark_minority_is_kept() -> None:
+    """Dark stripes a quarter of a tiling, ten times darker than its light ones, are found all
+    around the hole: its material, however dark."""
+    cols = np.indices((_H, _W))[1]
+    dark = (cols % 20) < 5
+    image = np.where(dark, 0.06, 0.75)[..., None] * np.array([1.0, 0.95, 0.9])
+    image = image * (1 + 0.02 * np.random.default_rng(2).standard_normal((_H, _W, 1)))
+    hole = _hole()
+    got = border_material(image, ~hole, hole, min_cells=64)
+    for colour in (dark, ~dark):
+        assert (got.exemplar & colour).sum() > 0.95 * (~hole & colour).sum()
