@@ -152,8 +152,10 @@ def fill_surface(
             lambda _level, preview: progress(planeraster.sample_raster(raster, preview, points)))
         try:
             footprint = _footprint(raster) if options.structure else None
+            # the repainted cells are composed anew, but what they show still weighs the copies there
             filled = fill_structured(image, exemplar, to_fill, options.synthesis, structure=options.structure,
-                                     footprint=footprint, seed=options.seed, progress=on_level, cancel=cancel)
+                                     footprint=footprint, guide=values, guided=material.replaced,
+                                     seed=options.seed, progress=on_level, cancel=cancel)
         except DimredError:
             pass  # too little exemplar: the mean below is the honest fallback, reported by the caller
     if filled is None:

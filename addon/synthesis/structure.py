@@ -57,13 +57,15 @@ class StructureFill:
 
 
 def structure_fill(image: np.ndarray, known: np.ndarray, hole: np.ndarray, *, footprint: np.ndarray | None = None,
+                   guide: np.ndarray | None = None, guided: np.ndarray | None = None,
                    seed: int = 0) -> StructureFill | None:
     """The `hole` of `image` (H, W, C) composed from shifted copies of its `known` pixels, or
     None where the texture has no dominant translation or no copy reaches the hole. On planks
     (`_plank_axis`) each line along them is interpolated between its visible ends instead
-    (`lines`), the copies giving only their fine detail. `seed` varies the labels (the axis
-    shifts' lengths, or which repeats of a tiling): another seed gives another, equally
-    continuous fill."""
+    (`lines`), the copies giving only their fine detail. `guide` (H, W, C) is what the
+    photograph shows at the `guided` hole pixels, which were seen but repainted (`shift_map`).
+    `seed` varies the labels (the axis shifts' lengths, or which repeats of a tiling): another
+    seed gives another, equally continuous fill."""
     image = np.asarray(image, np.float32)
     known = np.asarray(known, bool) & ~hole
     if known.sum() < hole.sum():  # too little floor seen to tell a repeat from a coincidence
@@ -79,7 +81,7 @@ def structure_fill(image: np.ndarray, known: np.ndarray, hole: np.ndarray, *, fo
         # planks of random shades repeat nothing as a whole, but match themselves along their length
         if not (relative_difference(image, known, hole, shifts) <= DOMINANT).any():
             return None
-    composed = shift_map(image, known, hole, shifts, footprint=footprint)
+    composed = shift_map(image, known, hole, shifts, footprint=footprint, guide=guide, guided=guided)
     if not composed.covered.any():
         return None
     along = _plank_axis(image, known, hole)
@@ -112,11 +114,13 @@ class Filled:
 
 
 def fill_structured(image: np.ndarray, known: np.ndarray, hole: np.ndarray, params: SynthesisParams, *,
-                    structure: bool = True, footprint: np.ndarray | None = None, seed: int = 0,
+                    structure: bool = True, footprint: np.ndarray | None = None,
+                    guide: np.ndarray | None = None, guided: np.ndarray | None = None, seed: int = 0,
                     progress: ProgressFn | None = None, cancel: CancelFn | None = None) -> Filled:
     """`image` with its `hole` filled: composed from shifted copies where the texture repeats
     (with `structure`), the rest by the order-independent synthesis (`texture.fill_with_sources`,
     which raises `DimredError` on too little exemplar); and where each pixel was copied from.
+    `guide` at the `guided` hole pixels weighs the copies there (`structure_fill`).
     `progress(level, preview)` gets the composed image first (level -1) where the synthesis has
     more to do, then the synthesis's levels."""
     # Composed whatever the period of the repeats. Checkers of 17 cells (rotated_world at
@@ -125,7 +129,8 @@ def fill_structured(image: np.ndarray, known: np.ndarray, hole: np.ndarray, para
     # them (stool, warm_cylinder at 1024x512) were once left to the synthesis; since the copies
     # are read from the panorama itself they score 0.44 and 0.60 composed, against 0.16 and 0.55
     # per pixel, with less object and shadow error (0.131 and 0.212, against 0.142 and 0.225).
-    got = structure_fill(image, known, hole, footprint=footprint, seed=seed) if structure else None
+    got = (structure_fill(image, known, hole, footprint=footprint, guide=guide, guided=guided, seed=seed)
+           if structure else None)
     rest = hole if got is None else hole & ~got.covered
     if got is not None and not rest.any():
         return Filled(got.image, np.full((*hole.shape, 2), -1, np.int64), got)

@@ -46,8 +46,9 @@ FAILING: dict[tuple[str, str], str] = {
     # (0.722 and 0.347), is now left out of the exemplar as far darker than the hole's border.
     ("hotel_walls", "total"): "measured 0.589",
     ("hotel_walls", "mean_error"): "measured 0.095",
-    # The yellow floor line is continued into the hole with a branch the truth does not have.
-    ("workshop_box", "total"): "measured 0.367",
+    # The fill follows the yellow floor line (mean error 0.014); most of the total is the light
+    # error outside the object (0.154, above).
+    ("workshop_box", "total"): "measured 0.361",
 }
 
 

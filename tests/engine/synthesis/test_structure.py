@@ -263,3 +263,38 @@ def test_each_plank_keeps_its_own_shade_across_the_hole(transpose):
     assert interpolated < 0.5 * copied
     tiles = structure_fill(np.where(hole[..., None], 0, _tiles()), ~hole, hole)
     assert tiles.detail == 1.0 and tiles.along is None and tiles.lines is None
+
+
+def _floor_with_lane_bend():
+    """A plain floor with a short stretch of painted line (a lane's bend) far from a hole whose
+    top rows were seen but repainted: two shifts copy equally seamless plain floor to every
+    pixel beside the hole, the first also the line's stretch into the hole's inside."""
+    img = np.full((40, 60, 3), [0.30, 0.35, 0.10], np.float32)
+    img[2:10, 40:44] = [0.90, 0.80, 0.05]
+    hole = np.zeros((40, 60), bool)
+    hole[20:36, 10:31] = True
+    repainted = np.zeros_like(hole)
+    repainted[20:26, 10:31] = True  # the photograph shows plain floor there, under a highlight
+    shifts = np.array([[-19, 22], [0, 25]])  # (-19, 22) puts the line at rows 21-28, columns 18-21
+    return img, hole, repainted, shifts
+
+
+def test_repainted_band_guides_the_copies_away_from_a_stray_line():
+    """A line that ends in the repainted band is no cheaper than plain floor there: what the
+    photograph shows in the band decides between copies the border cannot tell apart."""
+    img, hole, repainted, shifts = _floor_with_lane_bend()
+    guide = img * 1.2
+    got = shift_map(img, ~hole, hole, shifts, guide=guide, guided=repainted)
+    assert got.covered[hole].all()
+    plain = np.broadcast_to(img[0, 0], got.image[hole].shape)
+    np.testing.assert_allclose(got.image[hole], plain, atol=1e-6)  # no stretch of line in the hole
+
+
+def test_guide_unlike_every_copy_prefers_none():
+    """Where the photograph shows something unlike every copy (a chair's dark leg), every copy
+    pays the same truncated cost: the labels are those without a guide."""
+    img, hole, repainted, shifts = _floor_with_lane_bend()
+    dark = np.full_like(img, -5.0)
+    free = shift_map(img, ~hole, hole, shifts[::-1])
+    guided = shift_map(img, ~hole, hole, shifts[::-1], guide=dark, guided=repainted)
+    np.testing.assert_array_equal(guided.labels, free.labels)
