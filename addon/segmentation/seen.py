@@ -19,13 +19,13 @@ from ..geometry.planeraster import Frame
 from ..geometry.raycast import Projection, trace_panorama
 from ..geometry.span import pixel_span
 from ..light.radiosity import LUMA
+from ..quality import Params
 from ..report import Report
 from ..side_by_side import both
 from .grabcut import ObjectSegmentation, segment_object
 from .masks import blur, box_mean, dilate
 from .user_mask import UserMask
 
-MAX_PIXELS = 1 << 20  # the largest window segmented at full resolution (the default)
 _COARSE_WIDTH = 512  # the panorama's width at which the window is first found
 _PAD = 2  # pixels the window reaches past the band
 _MIN_BAND = 3
@@ -100,9 +100,9 @@ class SeenObject:
         return out
 
 
-def seen_object(hdri: np.ndarray, geo: Geometry, index: int, *, segment: bool = True, band: float = 0.12,
-                max_pixels: int = MAX_PIXELS, mask: UserMask | None = None, rep: Report | None = None
-                ) -> SeenObject | None:
+def seen_object(hdri: np.ndarray, geo: Geometry, index: int, *, segment: bool = True,
+                band: float = Params.segmentation_band, max_pixels: int = Params.segmentation_pixels,
+                mask: UserMask | None = None, rep: Report | None = None) -> SeenObject | None:
     """The object `index` of `geo` (probe frame) as the panorama `hdri` (H, W, 3) shows it; None
     when no pixel sees it (nor does the user's mask add any). `band` is the half-width of
     the band the image decides, as a share of the object's angular size. DimredError when the
