@@ -4,8 +4,10 @@ windows, lamps; `scenes.spec.PHOTO_SPECS`), through the engine as the command li
     .venv/bin/python benchmarks/bench_photo_groundtruth.py [--scenes a,b] [--width 512] [--samples 32]
 Prints a markdown table of `scenes.metrics.clean_removal_scores`: light error (beside it the
 renders' noise floor, `scenes.metrics.noise_floor`, as bench_removal gives it), fill structure,
-detail, fill mean error, total (object + shadow error left), far damage, bruise share (hidden
-pixels darker than 0.8 x the clean surface's 1st percentile), then the surfaces filled and the
+detail, fill mean error, total (object + shadow error left), the mean error and total of the
+truth's own neighbouring patch pasted over the object (`scenes.metrics.neighbour_patch_scores`:
+a plausible surface that is not the hidden one, under exactly the right light), far damage,
+bruise share (hidden pixels darker than 0.8 x the clean surface's 1st percentile), then the surfaces filled and the
 source of their exemplars where the report names it (`filled_surfaces`), and the seconds.
 The table goes to docs/results/bench_photo_groundtruth.md. out/photo_gt/<scene>.png shows the
 panorama with the object, the truth without it and ours side by side, each above a crop around
@@ -67,17 +69,19 @@ def main() -> None:
 
     OUT.mkdir(parents=True, exist_ok=True)
     table = Table(["scene", "photo", "object", "light", "noise floor", "structure", "detail", "mean error", "total",
-                   "far damage", "bruise share", "filled (source)", "seconds"],
+                   "neighbour mean / total", "far damage", "bruise share", "filled (source)", "seconds"],
                   title=f"{args.width}x{args.width // 2} at {args.samples} samples, balanced, exact proxies")
     for gt in ground_truths(args):
         s = gt.spec
         r = remove_object(gt.scene, s.remove, quality="balanced")
         edit = gt.input + r.difference
         f = metrics.clean_removal_scores(gt.input, edit, gt.truth, gt.mask)
+        n = metrics.neighbour_patch_scores(gt.input, gt.truth, gt.mask)
         write_png(OUT / f"{s.name}.png", comparison([gt.input, gt.truth, edit], gt.mask))
         table.row(s.name, s.room.floor.photo.source, s.removed_object().kind, f"{f['light']:.3f}",
                   f"{metrics.noise_floor(gt.input, gt.truth, gt.mask):.3f}", f"{f['structure']:.3f}",
                   f"{f['detail']:.2f}", f"{f['mean_error']:.3f}", f"{f['total']:.3f}",
+                  f"{n['mean_error']:.3f} / {n['total']:.3f}",
                   f"{f['far_damage']:.3f}", f"{f['bruise_share']:.3f}", _sources(r.report),
                   f"{r.report['seconds']['total']:.1f}")
     write(table, notes=[BOUNDS])

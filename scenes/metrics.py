@@ -336,3 +336,32 @@ def clean_removal_scores(input: np.ndarray, edit: np.ndarray, truth: np.ndarray,
         "far_damage": far_damage(input, edit, truth, object_mask, region),
         "bruise_share": bruise_share(edit, truth, object_mask),
     }
+
+
+def neighbour_patch_scores(input: np.ndarray, truth: np.ndarray, object_mask: np.ndarray) -> dict[str, float]:
+    """`clean_removal_scores` of the truth itself with the object's pixels replaced by the
+    truth's own neighbouring patch: the object's pixels shifted by its extent (plus 2 px) left,
+    right, up or down, whichever scores the lowest total; shifts whose source overlaps the object
+    (over 5 % of it) or leaves the panorama are skipped. The light is exactly right and the fill
+    is the room's own surface beside the hole, so its `total` and `mean_error` are what a
+    plausible texture that is not the hidden one scores: a reference for a fill's, not a bound
+    (a fill that continues tiles or planks in phase can score lower). Adds `shift` (rows,
+    columns). Raises ValueError if no shift fits."""
+    mask = np.asarray(object_mask, dtype=bool)
+    rows, cols = np.nonzero(mask)
+    height, width = rows.max() - rows.min() + 3, cols.max() - cols.min() + 3
+    best = None
+    for dr, dc in ((0, width), (0, -width), (height, 0), (-height, 0)):
+        if rows.min() + dr < 0 or rows.max() + dr >= mask.shape[0]:
+            continue
+        source = np.roll(mask, (-dr, -dc), axis=(0, 1))
+        if (source & mask).sum() > 0.05 * mask.sum():
+            continue
+        edit = np.asarray(truth, dtype=np.float64).copy()
+        edit[mask] = truth[(rows + dr, (cols + dc) % mask.shape[1])]
+        scores = clean_removal_scores(input, edit, truth, mask)
+        if best is None or scores["total"] < best["total"]:
+            best = {**scores, "shift": (int(dr), int(dc))}
+    if best is None:
+        raise ValueError("no neighbouring patch of the object's size fits beside it")
+    return best

@@ -218,3 +218,29 @@ def test_bruise_share_counts_fill_pixels_darker_than_the_clean_surface() -> None
     assert M.bruise_share(edit, nearby, mask, width_px=4) == 0.0
     with pytest.raises(ValueError, match="empty"):
         M.bruise_share(truth, truth, np.zeros((H, W), bool))
+
+
+def test_neighbour_patch_takes_the_shift_that_matches_the_hidden_surface() -> None:
+    inp, truth, mask, _ = _scene()
+    # Rows differ and columns do not: a patch beside the object is the hidden one exactly, a
+    # patch above or below it is not.
+    striped = np.broadcast_to(truth[:, :1], truth.shape).copy()
+    inp = np.where(mask[..., None], inp, striped)
+    got = M.neighbour_patch_scores(inp, striped, mask)
+    assert got["shift"][0] == 0 and abs(got["shift"][1]) == 3 + 2
+    assert got["total"] == pytest.approx(0.0, abs=1e-12) and got["mean_error"] == pytest.approx(0.0, abs=1e-12)
+
+
+def test_neighbour_patch_of_a_noisy_surface_keeps_its_detail_and_misses_its_pixels() -> None:
+    inp, truth, mask, _ = _scene(seed=3)
+    got = M.neighbour_patch_scores(inp, truth, mask)
+    assert got["light"] == pytest.approx(0.0, abs=1e-12)  # the light is the truth's
+    assert 0.5 < got["detail"] < 2.0 and got["total"] > 0.0
+
+
+def test_neighbour_patch_needs_room_beside_the_object() -> None:
+    inp, truth, _, _ = _scene()
+    band = np.zeros((H, W), bool)
+    band[2:H - 2, :] = True  # all the way round and nearly pole to pole
+    with pytest.raises(ValueError, match="no neighbouring patch"):
+        M.neighbour_patch_scores(inp, truth, band)
