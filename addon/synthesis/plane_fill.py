@@ -18,10 +18,11 @@ from ..geometry import latlong, planeraster
 from ..light.radiosity import LUMA
 from ..segmentation.masks import box_mean
 from .lines import sharpened_across
-from .material import Material, border_material
+from .material import Material, border_material, wall_material
 from .plank_profile import PlankProfile, fold_profile
 from .structure import Filled, fill_structured
 from .texture import SynthesisParams
+from .wall_columns import fill_wall, is_wall
 
 _MAX_CELLS = 512 * 512  # bounds the raster (and the exemplar) whatever the panorama size
 _DEPTH_TOLERANCE = 0.02  # relative: a cell is where a ray meets its surface within this
@@ -140,7 +141,10 @@ def fill_surface(
             hole[np.clip(r + dr, 0, h - 1), np.clip(c + dc, 0, w - 1)] = True
     hole |= flags == planeraster.HIDDEN
     hole &= ~known
-    material = border_material(values, known, hole, min_cells=_MIN_KNOWN)
+    # A wall's hole is continued column by column from the wall itself (`wall_columns`): what the
+    # photograph shows on it beside the hole (a door, a dark panel) is no clutter to leave out.
+    wall = is_wall(plane.normal)
+    material = wall_material(known) if wall else border_material(values, known, hole, min_cells=_MIN_KNOWN)
     # Only the hole's own material is copied; other things seen beside the hole (the object's
     # legs, a rug's edge) are repainted as context so that nothing continues them into it.
     exemplar, to_fill = material.exemplar, hole | material.replaced
@@ -153,9 +157,11 @@ def fill_surface(
         try:
             footprint = _footprint(raster) if options.structure else None
             # the repainted cells are composed anew, but what they show still weighs the copies there
-            filled = fill_structured(image, exemplar, to_fill, options.synthesis, structure=options.structure,
-                                     footprint=footprint, guide=values, guided=material.replaced,
-                                     seed=options.seed, progress=on_level, cancel=cancel)
+            filled = (fill_wall(image, exemplar, to_fill, options.synthesis, seed=options.seed, progress=on_level,
+                                cancel=cancel) if wall else
+                      fill_structured(image, exemplar, to_fill, options.synthesis, structure=options.structure,
+                                      footprint=footprint, guide=values, guided=material.replaced,
+                                      seed=options.seed, progress=on_level, cancel=cancel))
         except DimredError:
             pass  # too little exemplar: the mean below is the honest fallback, reported by the caller
     if filled is None:
