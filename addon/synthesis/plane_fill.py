@@ -196,9 +196,9 @@ def _filled_rho(filled: Filled, panorama: PanoramaReflectance, plane: HiddenPlan
     if profile is None:
         rho = planeraster.sample_raster(raster, _sharpened_lines(filled), plane.points)
         weight = 1.0 if structure is None else structure.detail
-        return _with_photograph_detail(rho, panorama, plane, raster, _copy_field(filled, image, weight))
+        return _with_photograph_detail(rho, panorama, plane, raster, _copy_field(filled, weight))
     rho = planeraster.sample_raster(raster, filled.image, plane.points)
-    rho = _with_photograph_detail(rho, panorama, plane, raster, _copy_field(filled, image, _PROFILED_DETAIL))
+    rho = _with_photograph_detail(rho, panorama, plane, raster, _copy_field(filled, _PROFILED_DETAIL))
     on_lines = structure.lines[_nearest_cells(raster, plane.points)]
     hidden = plane.points[on_lines]
     rho[on_lines] *= profile.at(hidden @ across, hidden @ _along(raster, structure.along))[:, None]
@@ -257,18 +257,23 @@ def _footprint(raster: planeraster.PlaneRaster) -> np.ndarray:
 class _CopyField:
     """Per raster cell filled by a copy: `shift` (H, W, 2) from the cell to its source, in cells;
     `copied` (H, W) where there is one; `detail` (H, W) the weight of the photograph's finer
-    detail there; `exemplar` (H, W, C) the raster the copies were taken from."""
+    detail there; `coarse` (H, W, C) the filled raster, which the photograph's detail is
+    measured against at the copies' sources."""
 
     shift: np.ndarray
     copied: np.ndarray
     detail: np.ndarray
-    exemplar: np.ndarray
+    coarse: np.ndarray
 
 
-def _copy_field(filled: Filled, exemplar: np.ndarray, composed_detail: float) -> _CopyField:
+def _copy_field(filled: Filled, composed_detail: float) -> _CopyField:
     """Where the fill copied each cell from: the shift map's shifts where composed (their
-    detail weighed `composed_detail`), the synthesis's sources (pixels of `exemplar`, the raster
-    before the fill) elsewhere."""
+    detail weighed `composed_detail`), the synthesis's sources elsewhere. The detail is measured
+    against the filled raster, not the raster before the fill: a source beside the hole is
+    looked up bilinearly with the hole's cells, which held the exemplar's mean before the fill.
+    Against it, a dark door's cells at the hole's border read as far darker than their
+    surroundings and left a dotted dark line along the border of a wall's fill (hotel_walls,
+    the hotel photograph's curtain)."""
     sources, structure = filled.sources, filled.structure
     copied = sources[..., 0] >= 0
     shift = np.where(copied[..., None], sources - np.indices(copied.shape).transpose(1, 2, 0), 0)
@@ -278,7 +283,7 @@ def _copy_field(filled: Filled, exemplar: np.ndarray, composed_detail: float) ->
         shift[covered] = structure.shifts.shifts[structure.shifts.labels[covered]]
         detail[covered] = composed_detail
         copied = copied | covered
-    return _CopyField(shift, copied, detail, exemplar)
+    return _CopyField(shift, copied, detail, filled.image)
 
 
 def _with_photograph_detail(rho: np.ndarray, panorama: PanoramaReflectance, plane: HiddenPlane,
@@ -302,7 +307,7 @@ def _with_photograph_detail(rho: np.ndarray, panorama: PanoramaReflectance, plan
     source = plane.points[sel] + t[:, :1] * raster.v + t[:, 1:] * raster.u
     copy, weight = planeraster.sample_points_keeping_grain(source, panorama.rho, panorama.shows(plane.surface),
                                                            frame=maps.frame)
-    coarse = planeraster.sample_raster(raster, field.exemplar, source)
+    coarse = planeraster.sample_raster(raster, field.coarse, source)
     ok = weight > 0.5
     out = rho.copy()
     out[sel[ok]] += field.detail[r[sel], c[sel]][ok, None] * (copy[ok] - coarse[ok])
