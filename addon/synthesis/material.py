@@ -54,7 +54,8 @@ _MIN_SHARE_WARN = 0.5  # below this share of the seen cells, the surface is most
 class Material:
     """The known cells of the hole's material (`exemplar`), the other known cells near the hole
     that the fill repaints as context (`replaced`), and what the exemplar is: `source`
-    'border material' or, where too few cells match, 'whole surface'."""
+    'border material', 'whole surface' where too few cells match, or 'wall columns' (a wall's
+    every seen cell, continued along its columns: `wall_material`)."""
 
     exemplar: np.ndarray
     replaced: np.ndarray
@@ -66,7 +67,7 @@ class Material:
     def mostly_other(self) -> bool:
         """Most of the surface seen around the hole is of another material (clutter, a rug), or
         none of it matches."""
-        return self.decided and (self.source != "border material" or self.share < _MIN_SHARE_WARN)
+        return self.decided and (self.source == "whole surface" or self.share < _MIN_SHARE_WARN)
 
 
 def border_material(image: np.ndarray, known: np.ndarray, hole: np.ndarray, *, min_cells: int) -> Material:
@@ -140,6 +141,12 @@ def border_material(image: np.ndarray, known: np.ndarray, hole: np.ndarray, *, m
     # Only what is wider than a line is repainted beside the hole: a thin stripe is only left out.
     return Material(exemplar=exemplar, replaced=near & wide, source="border material",
                     share=float(exemplar.sum() / known.sum()))
+
+
+def wall_material(known: np.ndarray) -> Material:
+    """A wall's exemplar: every `known` cell, nothing repainted. What stands on a wall beside the
+    hole (a door, its frame) is continued into it along the wall's columns (`wall_columns`)."""
+    return Material(exemplar=known, replaced=np.zeros_like(known), source="wall columns", share=1.0)
 
 
 def _dark_clutter(log_y: np.ndarray, candidates: np.ndarray, band: np.ndarray) -> np.ndarray:

@@ -18,10 +18,11 @@ from ..geometry import latlong, planeraster
 from ..light.radiosity import LUMA
 from ..segmentation.masks import box_mean
 from .lines import sharpened_across
-from .material import Material, border_material
+from .material import Material, border_material, wall_material
 from .plank_profile import PlankProfile, fold_profile
 from .structure import Filled, fill_structured
 from .texture import SynthesisParams
+from .wall_columns import fill_wall, is_wall
 
 _MAX_CELLS = 512 * 512  # bounds the raster (and the exemplar) whatever the panorama size
 _DEPTH_TOLERANCE = 0.02  # relative: a cell is where a ray meets its surface within this
@@ -140,7 +141,10 @@ def fill_surface(
             hole[np.clip(r + dr, 0, h - 1), np.clip(c + dc, 0, w - 1)] = True
     hole |= flags == planeraster.HIDDEN
     hole &= ~known
-    material = border_material(values, known, hole, min_cells=_MIN_KNOWN)
+    # A wall's hole is continued column by column from the wall itself (`wall_columns`): what the
+    # photograph shows on it beside the hole (a door, a dark panel) is no clutter to leave out.
+    wall = is_wall(plane.normal)
+    material = wall_material(known) if wall else border_material(values, known, hole, min_cells=_MIN_KNOWN)
     # Only the hole's own material is copied; other things seen beside the hole (the object's
     # legs, a rug's edge) are repainted as context so that nothing continues them into it.
     exemplar, to_fill = material.exemplar, hole | material.replaced
@@ -153,9 +157,11 @@ def fill_surface(
         try:
             footprint = _footprint(raster) if options.structure else None
             # the repainted cells are composed anew, but what they show still weighs the copies there
-            filled = fill_structured(image, exemplar, to_fill, options.synthesis, structure=options.structure,
-                                     footprint=footprint, guide=values, guided=material.replaced,
-                                     seed=options.seed, progress=on_level, cancel=cancel)
+            filled = (fill_wall(image, exemplar, to_fill, options.synthesis, seed=options.seed, progress=on_level,
+                                cancel=cancel) if wall else
+                      fill_structured(image, exemplar, to_fill, options.synthesis, structure=options.structure,
+                                      footprint=footprint, guide=values, guided=material.replaced,
+                                      seed=options.seed, progress=on_level, cancel=cancel))
         except DimredError:
             pass  # too little exemplar: the mean below is the honest fallback, reported by the caller
     if filled is None:
@@ -190,9 +196,9 @@ def _filled_rho(filled: Filled, panorama: PanoramaReflectance, plane: HiddenPlan
     if profile is None:
         rho = planeraster.sample_raster(raster, _sharpened_lines(filled), plane.points)
         weight = 1.0 if structure is None else structure.detail
-        return _with_photograph_detail(rho, panorama, plane, raster, _copy_field(filled, image, weight))
+        return _with_photograph_detail(rho, panorama, plane, raster, _copy_field(filled, weight))
     rho = planeraster.sample_raster(raster, filled.image, plane.points)
-    rho = _with_photograph_detail(rho, panorama, plane, raster, _copy_field(filled, image, _PROFILED_DETAIL))
+    rho = _with_photograph_detail(rho, panorama, plane, raster, _copy_field(filled, _PROFILED_DETAIL))
     on_lines = structure.lines[_nearest_cells(raster, plane.points)]
     hidden = plane.points[on_lines]
     rho[on_lines] *= profile.at(hidden @ across, hidden @ _along(raster, structure.along))[:, None]
@@ -251,18 +257,23 @@ def _footprint(raster: planeraster.PlaneRaster) -> np.ndarray:
 class _CopyField:
     """Per raster cell filled by a copy: `shift` (H, W, 2) from the cell to its source, in cells;
     `copied` (H, W) where there is one; `detail` (H, W) the weight of the photograph's finer
-    detail there; `exemplar` (H, W, C) the raster the copies were taken from."""
+    detail there; `coarse` (H, W, C) the filled raster, which the photograph's detail is
+    measured against at the copies' sources."""
 
     shift: np.ndarray
     copied: np.ndarray
     detail: np.ndarray
-    exemplar: np.ndarray
+    coarse: np.ndarray
 
 
-def _copy_field(filled: Filled, exemplar: np.ndarray, composed_detail: float) -> _CopyField:
+def _copy_field(filled: Filled, composed_detail: float) -> _CopyField:
     """Where the fill copied each cell from: the shift map's shifts where composed (their
-    detail weighed `composed_detail`), the synthesis's sources (pixels of `exemplar`, the raster
-    before the fill) elsewhere."""
+    detail weighed `composed_detail`), the synthesis's sources elsewhere. The detail is measured
+    against the filled raster, not the raster before the fill: a source beside the hole is
+    looked up bilinearly with the hole's cells, which held the exemplar's mean before the fill.
+    Against it, a dark door's cells at the hole's border read as far darker than their
+    surroundings and left a dotted dark line along the border of a wall's fill (hotel_walls,
+    the hotel photograph's curtain)."""
     sources, structure = filled.sources, filled.structure
     copied = sources[..., 0] >= 0
     shift = np.where(copied[..., None], sources - np.indices(copied.shape).transpose(1, 2, 0), 0)
@@ -272,7 +283,7 @@ def _copy_field(filled: Filled, exemplar: np.ndarray, composed_detail: float) ->
         shift[covered] = structure.shifts.shifts[structure.shifts.labels[covered]]
         detail[covered] = composed_detail
         copied = copied | covered
-    return _CopyField(shift, copied, detail, exemplar)
+    return _CopyField(shift, copied, detail, filled.image)
 
 
 def _with_photograph_detail(rho: np.ndarray, panorama: PanoramaReflectance, plane: HiddenPlane,
@@ -296,7 +307,7 @@ def _with_photograph_detail(rho: np.ndarray, panorama: PanoramaReflectance, plan
     source = plane.points[sel] + t[:, :1] * raster.v + t[:, 1:] * raster.u
     copy, weight = planeraster.sample_points_keeping_grain(source, panorama.rho, panorama.shows(plane.surface),
                                                            frame=maps.frame)
-    coarse = planeraster.sample_raster(raster, field.exemplar, source)
+    coarse = planeraster.sample_raster(raster, field.coarse, source)
     ok = weight > 0.5
     out = rho.copy()
     out[sel[ok]] += field.detail[r[sel], c[sel]][ok, None] * (copy[ok] - coarse[ok])

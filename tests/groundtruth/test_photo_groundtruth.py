@@ -41,11 +41,14 @@ FAILING: dict[tuple[str, str], str] = {
     # rug's stripes farther out are kept (the exemplar's mean 0.40, the border's 0.50).
     ("hotel_box", "total"): "measured 0.448",
     ("hotel_box", "mean_error"): "measured 0.181",
-    # The wall's fill (too little of its material seen to synthesise) at the mean of the door
-    # frame. The desk's dark side, once copied into the floor behind the armchair-sized box
-    # (0.722 and 0.347), is now left out of the exemplar as far darker than the hole's border.
-    ("hotel_walls", "total"): "measured 0.589",
-    ("hotel_walls", "mean_error"): "measured 0.095",
+    # The walls are continued along their columns (`wall_columns`): the white wall and the dark
+    # door come down through the hole to the proxy's floor line (mean error 0.095 -> 0.029).
+    # The photograph projected on the proxy's wall shows the floor under the door (its door
+    # stands farther back than the proxy's wall), so the continued door is dark where the truth
+    # is floor-coloured, and its edges over the pale wall add more detail than the truth's.
+    ("hotel_walls", "total"): "measured 0.442",
+    ("hotel_walls", "detail"): "measured 1.28",
+    ("hotel_walls", "bruise_share"): "measured 0.111",
     # The fill follows the yellow floor line (mean error 0.014); most of the total is the light
     # error outside the object (0.154, above).
     ("workshop_box", "total"): "measured 0.361",
