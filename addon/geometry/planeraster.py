@@ -41,12 +41,23 @@ class PlaneRaster:
         return rel @ self.v / self.cell - 0.5, rel @ self.u / self.cell - 0.5
 
 
+# A plane whose normal lies within about 25 degrees of the horizontal is a wall: its raster's rows
+# run upward (`plane_axes`), the fill continues its columns and its edges are no floor line.
+_WALL_NORMAL_Z = 0.9
+
+
+def is_wall(normal: np.ndarray) -> bool:
+    """Whether the plane of `normal` (3,) is a wall: its raster's axis 0 (v) is vertical."""
+    n = np.asarray(normal, dtype=np.float64)
+    return abs(float(n[2])) <= _WALL_NORMAL_Z * float(np.linalg.norm(n))
+
+
 def plane_axes(normal: np.ndarray, along: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Two unit axes spanning the plane. On a wall u is horizontal; on a floor or ceiling u
     follows `along` (the surface's own edges, see `edge_direction`), else the frame's x, so that
     tile and plank lines along the room's walls run along the raster's rows or columns."""
     n = np.asarray(normal, dtype=np.float64) / np.linalg.norm(normal)
-    if abs(n[2]) > 0.9:
+    if not is_wall(n):
         a = np.array([1.0, 0.0, 0.0]) if along is None else np.asarray(along, dtype=np.float64)
     else:
         a = np.cross([0.0, 0.0, 1.0], n)

@@ -22,7 +22,7 @@ from .material import Material, border_material, wall_material
 from .plank_profile import PlankProfile, fold_profile
 from .structure import Filled, fill_structured
 from .texture import SynthesisParams
-from .wall_columns import fill_wall, is_wall
+from .wall_columns import fill_wall
 
 _MAX_CELLS = 512 * 512  # bounds the raster (and the exemplar) whatever the panorama size
 _DEPTH_TOLERANCE = 0.02  # relative: a cell is where a ray meets its surface within this
@@ -143,7 +143,7 @@ def fill_surface(
     hole &= ~known
     # A wall's hole is continued column by column from the wall itself (`wall_columns`): what the
     # photograph shows on it beside the hole (a door, a dark panel) is no clutter to leave out.
-    wall = is_wall(plane.normal)
+    wall = planeraster.is_wall(plane.normal)
     material = wall_material(known) if wall else border_material(values, known, hole, min_cells=_MIN_KNOWN)
     # Only the hole's own material is copied; other things seen beside the hole (the object's
     # legs, a rug's edge) are repainted as context so that nothing continues them into it.
@@ -155,13 +155,15 @@ def fill_surface(
         on_level = None if progress is None else (
             lambda _level, preview: progress(planeraster.sample_raster(raster, preview, points)))
         try:
-            footprint = _footprint(raster) if options.structure else None
-            # the repainted cells are composed anew, but what they show still weighs the copies there
-            filled = (fill_wall(image, exemplar, to_fill, options.synthesis, seed=options.seed, progress=on_level,
-                                cancel=cancel) if wall else
-                      fill_structured(image, exemplar, to_fill, options.synthesis, structure=options.structure,
-                                      footprint=footprint, guide=values, guided=material.replaced,
-                                      seed=options.seed, progress=on_level, cancel=cancel))
+            if wall:
+                filled = fill_wall(image, exemplar, to_fill, options.synthesis, seed=options.seed, progress=on_level,
+                                   cancel=cancel)
+            else:
+                # the repainted cells are composed anew, but what they show still weighs the copies there
+                filled = fill_structured(image, exemplar, to_fill, options.synthesis, structure=options.structure,
+                                         footprint=_footprint(raster) if options.structure else None, guide=values,
+                                         guided=material.replaced, seed=options.seed, progress=on_level,
+                                         cancel=cancel)
         except DimredError:
             pass  # too little exemplar: the mean below is the honest fallback, reported by the caller
     if filled is None:

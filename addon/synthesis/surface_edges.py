@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..geometry import latlong
-from ..geometry.planeraster import Frame
+from ..geometry.planeraster import Frame, is_wall
 from ..segmentation.masks import dilate
 
 # Search range and bands, in pixel angles (pi / panorama height) at the hole: an eye-modelled
@@ -48,10 +48,9 @@ _OVER_PROXY = 4.0
 _MIN_SHIFT = 2.0
 _BESIDE = 0.3  # the stretch measured: the hole's along the edge and this share of it on either side
 _MIN_ADJACENT = 3  # pixel pairs across which two surfaces must meet near the hole to count as an edge
-# Only a floor's or a ceiling's edges (normal within 25 degrees of the vertical) are looked for: a
+# Only a floor's or a ceiling's edges (`planeraster.is_wall`: not a wall) are looked for: a
 # corner between two walls is a vertical line among many in a photograph (a door's frame, a
 # curtain's edge), which the search took for the corner on the photo-textured hotel room.
-_LEVEL = 0.9
 
 
 @dataclass(frozen=True)
@@ -200,7 +199,7 @@ def _meeting_pairs(labels: np.ndarray, planes: dict[int, SurfacePlane]) -> list[
     pairs, counts = np.unique(np.concatenate(found), axis=0, return_counts=True)
     return [(int(a), int(b)) for (a, b), n in zip(pairs, counts, strict=True)
             if n >= _MIN_ADJACENT and a in planes and b in planes
-            and (abs(planes[a].normal[2]) > _LEVEL) != (abs(planes[b].normal[2]) > _LEVEL)]
+            and is_wall(planes[a].normal) != is_wall(planes[b].normal)]
 
 
 def _edge(planes: dict[int, SurfacePlane], a: int, b: int, directions: np.ndarray, log_photo: np.ndarray,

@@ -21,17 +21,9 @@ from .lines import along_mean, interpolate_lines
 from .structure import Filled
 from .texture import CancelFn, ProgressFn, SynthesisParams, fill_with_sources
 
-# Surfaces whose normal lies within this of the horizontal are walls (`planeraster.plane_axes`
-# takes the same limit): their raster's rows run upward, its columns are the wall's verticals.
-_LEVEL = 0.9
-_COLUMN = 0  # the raster axis along a wall's verticals
+_COLUMN = 0  # the raster axis along a wall's verticals (`planeraster.is_wall`)
 # cells averaged at each end of a column: the border cell alone would carry its noise down the column
 _ENDS = 6
-
-
-def is_wall(normal: np.ndarray) -> bool:
-    """Whether a plane of unit `normal` (3,) is a wall (its raster's axis 0 is vertical)."""
-    return abs(float(normal[2])) <= _LEVEL
 
 
 def column_sources(known: np.ndarray, hole: np.ndarray) -> np.ndarray:

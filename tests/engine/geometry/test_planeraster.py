@@ -40,6 +40,13 @@ def test_axes_are_orthonormal_and_span_the_plane(normal):
         assert abs(u[2]) < 1e-12  # a wall's rows run horizontally
 
 
+def test_walls_are_the_planes_with_a_level_normal():
+    assert PR.is_wall(np.array([1.0, 0.0, 0.0])) and PR.is_wall(np.array([0.0, -0.9, 0.3]))
+    assert not PR.is_wall(np.array([0.0, 0.0, 1.0])) and not PR.is_wall(np.array([0.3, 0.0, -0.95]))
+    # a normal need not be of unit length
+    assert PR.is_wall(np.array([0.0, 3.0, 1.0])) and not PR.is_wall(np.array([0.0, 1.0, 3.0]))
+
+
 def test_raster_covers_the_hole_with_its_margin_and_respects_the_cell_budget():
     pts = np.array([[0.8, 0.8, FLOOR_Z], [1.2, 1.2, FLOOR_Z]])
     r = PR.build_raster(np.array([0, 0, 1.0]), pts, cell=0.01, margin=1.0, max_cells=10**6)

@@ -2,7 +2,7 @@
 import numpy as np
 
 from addon.synthesis.texture import SynthesisParams
-from addon.synthesis.wall_columns import column_sources, fill_columns, fill_wall, is_wall
+from addon.synthesis.wall_columns import column_sources, fill_columns, fill_wall
 
 
 def _door_beside_wall(shape=(60, 80)):
@@ -15,11 +15,6 @@ def _door_beside_wall(shape=(60, 80)):
     hole = np.zeros(shape, bool)
     hole[:25, 25:55] = True
     return image, ~hole, hole
-
-
-def test_walls_are_the_planes_with_a_level_normal():
-    assert is_wall(np.array([1.0, 0.0, 0.0])) and is_wall(np.array([0.0, -0.9, 0.3]))
-    assert not is_wall(np.array([0.0, 0.0, 1.0])) and not is_wall(np.array([0.3, 0.0, -0.95]))
 
 
 def test_the_door_edge_that_enters_the_hole_runs_on_down_to_the_wall_foot():
