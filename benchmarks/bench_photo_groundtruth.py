@@ -24,7 +24,6 @@ from rendered import ground_truths, scene_list_arguments
 from results import Table, write
 
 OUT = Path(__file__).resolve().parents[1] / "out" / "photo_gt"
-BOUNDS = "Bounds (issue 33): total <= 0.2, mean error <= 0.05, detail 0.8-1.2, bruise share <= 0.02, far damage <= 0.05"
 
 
 def comparison(images: list[np.ndarray], mask: np.ndarray, *, zoom: int = 3) -> np.ndarray:
@@ -84,7 +83,7 @@ def main() -> None:
                   f"{n['mean_error']:.3f} / {n['total']:.3f}",
                   f"{f['far_damage']:.3f}", f"{f['bruise_share']:.3f}", _sources(r.report),
                   f"{r.report['seconds']['total']:.1f}")
-    write(table, notes=[BOUNDS])
+    write(table, notes=[f"Bounds (issue 33): {metrics.bounds_text()}"])
 
 
 if __name__ == "__main__":

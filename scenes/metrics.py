@@ -315,6 +315,35 @@ def bruise_share(edit: np.ndarray, truth: np.ndarray, object_mask: np.ndarray, *
     return float((_blurred_y(edit)[mask] < darkest).mean())
 
 
+#: The bounds a removal on a photo-textured room is held to (issue 33), per figure of
+#: `clean_removal_scores`: (lowest, highest), None where there is no limit.
+CLEAN_REMOVAL_BOUNDS: dict[str, tuple[float | None, float | None]] = {
+    "total": (None, 0.2),
+    "mean_error": (None, 0.05),
+    "detail": (0.8, 1.2),
+    "bruise_share": (None, 0.02),
+    "far_damage": (None, 0.05),
+}
+
+
+def within_bounds(scores: dict[str, float], figures: tuple[str, ...] = tuple(CLEAN_REMOVAL_BOUNDS)) -> bool:
+    """Whether each of `figures` in `scores` lies within `CLEAN_REMOVAL_BOUNDS`."""
+    for figure in figures:
+        lo, hi = CLEAN_REMOVAL_BOUNDS[figure]
+        if (lo is not None and scores[figure] < lo) or (hi is not None and scores[figure] > hi):
+            return False
+    return True
+
+
+def bounds_text(figures: tuple[str, ...] = tuple(CLEAN_REMOVAL_BOUNDS)) -> str:
+    """'total <= 0.2, mean error <= 0.05, detail 0.8-1.2, ...': the bounds of `figures` in words."""
+    def one(figure: str) -> str:
+        lo, hi = CLEAN_REMOVAL_BOUNDS[figure]
+        name = figure.replace("_", " ")
+        return f"{name} <= {hi}" if lo is None else f"{name} {lo}-{hi}"
+    return ", ".join(one(f) for f in figures)
+
+
 def clean_removal_scores(input: np.ndarray, edit: np.ndarray, truth: np.ndarray,
                          object_mask: np.ndarray) -> dict[str, float]:
     """The figures a removal on a photo-textured room is held to:

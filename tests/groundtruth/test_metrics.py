@@ -244,3 +244,12 @@ def test_neighbour_patch_needs_room_beside_the_object() -> None:
     band[2:H - 2, :] = True  # all the way round and nearly pole to pole
     with pytest.raises(ValueError, match="no neighbouring patch"):
         M.neighbour_patch_scores(inp, truth, band)
+
+
+def test_the_bounds_in_words_and_a_draw_within_them() -> None:
+    assert M.bounds_text(("mean_error", "detail")) == "mean error <= 0.05, detail 0.8-1.2"
+    figures = ("mean_error", "detail", "total")
+    assert M.within_bounds({"mean_error": 0.05, "detail": 0.8, "total": 0.2}, figures)
+    assert not M.within_bounds({"mean_error": 0.01, "detail": 1.21, "total": 0.1}, figures)
+    assert not M.within_bounds({"mean_error": 0.01, "detail": 1.0, "total": 0.1, "bruise_share": 0.03,
+                                "far_damage": 0.0})

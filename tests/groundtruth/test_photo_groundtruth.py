@@ -20,14 +20,7 @@ from scenes import spec as S
 
 SCENES = ["hotel_box", "hotel_walls", "apartment_chair", "workshop_box"]
 SIZE = {"width": 256, "height": 128, "samples": 32}
-# figure: (lowest, highest) it may take.
-BOUNDS = {
-    "total": (None, 0.2),
-    "mean_error": (None, 0.05),
-    "detail": (0.8, 1.2),
-    "bruise_share": (None, 0.02),
-    "far_damage": (None, 0.05),
-}
+BOUNDS = M.CLEAN_REMOVAL_BOUNDS  # figure: (lowest, highest) it may take
 # (scene, figure): what the engine measured where it fails the bound (256x128). Of each total,
 # the error left outside the object (the relit shadow and light, region A) alone is 0.241
 # (hotel_box), 0.136 (hotel_walls) and 0.154 (workshop_box): no fill meets 0.2 there by itself.
