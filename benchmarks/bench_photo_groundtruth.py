@@ -49,10 +49,14 @@ def comparison(images: list[np.ndarray], mask: np.ndarray, *, zoom: int = 3) -> 
 
 
 def _sources(report: dict) -> str:
-    """The filled surfaces, each with its exemplars' source and their share of the surface, or
-    'mean' where too little was seen to synthesise."""
+    """The filled surfaces, each with its exemplars' source and their share of the surface (and
+    the cells of a band continued across the hole), or 'mean' where too little was seen to
+    synthesise."""
     def source(f: dict) -> str:
-        return f"{f['exemplar']} {f['exemplar_share']:.0%}" if f["synthesised"] else "mean"
+        if not f["synthesised"]:
+            return "mean"
+        band = f" + a band across, {f['band_cells']} cells" if f["band_cells"] else ""
+        return f"{f['exemplar']} {f['exemplar_share']:.0%}{band}"
 
     return ", ".join(f"{f['surface']}: {source(f)}" for f in report.get("filled_surfaces", [])) or "-"
 

@@ -139,6 +139,7 @@ def filled_reflectance(solution: Solution, revealed: Revealed, rep: Report, call
         surfaces.append({"surface": name, "pixels": len(sel), "raster": list(got.raster_shape),
                          "cell": round(got.cell, 5), "known_cells": got.known_cells, "hole_cells": got.hole_cells,
                          "synthesised": got.synthesised, "structured_cells": got.structured,
+                         "band_cells": got.band_cells,
                          "exemplar": got.material.source, "exemplar_share": round(got.material.share, 3),
                          "seconds": round(seconds, 4)})
     rep.info["filled_surfaces"] = surfaces

@@ -84,3 +84,25 @@ def blur(a: np.ndarray) -> np.ndarray:
         p = np.concatenate([m[:1], m, m[-1:]])
         out = np.moveaxis(0.25 * p[:-2] + 0.5 * p[1:-1] + 0.25 * p[2:], 0, axis)
     return np.ascontiguousarray(out)
+
+
+def components(mask: np.ndarray) -> tuple[np.ndarray, int]:
+    """(h, w) the 4-connected component (0..n-1) of each pixel of `mask` (-1 elsewhere), and n.
+    Each pixel takes its neighbours' smallest index until none changes, jumping along the chain
+    of indices it points to, so that a long thin component needs few rounds."""
+    m = np.asarray(mask, dtype=bool)
+    h, w = m.shape
+    none = h * w
+    index = np.where(m, np.arange(none).reshape(h, w), none)
+    while True:
+        p = np.pad(index, 1, constant_values=none)
+        least = np.where(m, np.minimum.reduce([index, p[:-2, 1:-1], p[2:, 1:-1], p[1:-1, :-2], p[1:-1, 2:]]), none)
+        flat = least.ravel()
+        linked = flat < none
+        flat[linked] = np.minimum(flat[linked], flat[flat[linked]])
+        if np.array_equal(least, index):
+            break
+        index = least
+    out = np.full((h, w), -1, dtype=np.int64)
+    roots, out[m] = np.unique(index[m], return_inverse=True)
+    return out, len(roots)

@@ -9,7 +9,7 @@ the hole.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -17,6 +17,7 @@ from ..errors import DimredError
 from ..geometry import latlong, planeraster
 from ..light.radiosity import LUMA
 from ..segmentation.masks import box_mean
+from .crossing import Crossing, fill_crossing, find_crossing
 from .lines import sharpened_across
 from .material import Material, border_material, wall_material
 from .plank_profile import PlankProfile, fold_profile
@@ -109,6 +110,7 @@ class SurfaceFill:
     synthesised: bool  # False: too little of the surface is seen; its mean reflectance is used
     material: Material  # which seen cells served as exemplar
     structured: int = 0  # hole cells composed from shifted copies (the rest: order-independent synthesis)
+    band_cells: int = 0  # hole cells of a band continued across the hole (`crossing`)
 
 
 def fill_surface(
@@ -145,6 +147,9 @@ def fill_surface(
     # photograph shows on it beside the hole (a door, a dark panel) is no clutter to leave out.
     wall = planeraster.is_wall(plane.normal)
     material = wall_material(known) if wall else border_material(values, known, hole, min_cells=_MIN_KNOWN)
+    crossing = None if wall else find_crossing(values, known, hole)
+    if crossing is not None:  # each colour is copied only into its own region: nothing to repaint
+        material = replace(material, replaced=np.zeros_like(material.replaced))
     # Only the hole's own material is copied; other things seen beside the hole (the object's
     # legs, a rug's edge) are repainted as context so that nothing continues them into it.
     exemplar, to_fill = material.exemplar, hole | material.replaced
@@ -155,7 +160,9 @@ def fill_surface(
         on_level = None if progress is None else (
             lambda _level, preview: progress(planeraster.sample_raster(raster, preview, points)))
         try:
-            if wall:
+            if crossing is not None:
+                filled = fill_crossing(crossing, values, known, options.synthesis, seed=options.seed, cancel=cancel)
+            elif wall:
                 filled = fill_wall(image, exemplar, to_fill, options.synthesis, seed=options.seed, progress=on_level,
                                    cancel=cancel)
             else:
@@ -173,7 +180,12 @@ def fill_surface(
     structure = None if filled is None else filled.structure
     return SurfaceFill(rho=rho, raster_shape=raster.shape, cell=raster.cell, known_cells=int(known.sum()),
                        hole_cells=int(to_fill.sum()), synthesised=filled is not None,
-                       structured=0 if structure is None else int(structure.covered.sum()), material=material)
+                       structured=0 if structure is None else int(structure.covered.sum()), material=material,
+                       band_cells=_band_cells(crossing) if filled is not None else 0)
+
+
+def _band_cells(crossing: Crossing | None) -> int:
+    return 0 if crossing is None else int((crossing.regions == crossing.band).sum())
 
 
 def _sharpened_lines(filled: Filled) -> np.ndarray:

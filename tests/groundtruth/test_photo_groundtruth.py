@@ -46,9 +46,16 @@ FAILING: dict[tuple[str, str], str] = {
     ("hotel_walls", "total"): "measured 0.442",
     ("hotel_walls", "detail"): "measured 1.28",
     ("hotel_walls", "bruise_share"): "measured 0.111",
-    # The fill follows the yellow floor line (mean error 0.014); most of the total is the light
-    # error outside the object (0.154, above).
-    ("workshop_box", "total"): "measured 0.361",
+    # The yellow floor line crosses the hole between the green floor and the brown one: it is
+    # continued as a strip, each side synthesised from its own colour (`crossing`; structure
+    # 0.956, mean error 0.023). Most of the total is the light error outside the object (0.154,
+    # above). At this size the strip and the sides are synthesised from a few hundred cells of
+    # their colour right beside the hole, whose copies add less of the photograph's fine detail
+    # than copies from the whole floor did (0.91 before the strip); at 512x256 and 128 samples
+    # the detail is 1.03 (bench_photo_groundtruth); at 512 and 1024, 16 and 64 samples, its
+    # median 0.91 and the worst draw 0.75 (bench_photo_stability).
+    ("workshop_box", "total"): "measured 0.294",
+    ("workshop_box", "detail"): "measured 0.705",
 }
 
 

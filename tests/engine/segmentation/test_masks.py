@@ -4,7 +4,18 @@ from __future__ import annotations
 
 import numpy as np
 
-from addon.segmentation.masks import blur, boundary, box_mean, box_sum, dilate, double, erode, halve, outline
+from addon.segmentation.masks import (
+    blur,
+    boundary,
+    box_mean,
+    box_sum,
+    components,
+    dilate,
+    double,
+    erode,
+    halve,
+    outline,
+)
 
 
 def _direct_box_sum(a: np.ndarray, r: int) -> np.ndarray:
@@ -82,3 +93,19 @@ def test_blur_keeps_flat_regions_and_sums():
     spike[3, 3] = 16.0
     assert np.isclose(blur(spike).sum(), 16.0)
     assert blur(spike)[3, 3] == 4.0 and blur(spike)[2, 2] == 1.0
+
+
+def test_components_are_four_connected_and_follow_long_thin_shapes():
+    mask = np.zeros((9, 12), bool)
+    mask[0, :] = mask[:, 11] = True  # one long L along two edges
+    mask[3:5, 1:3] = True  # a block
+    mask[6, 6] = mask[7, 7] = True  # diagonal neighbours: two components
+    rows, cols = np.indices(mask.shape)
+    snake = (rows % 4 != 1) | ((rows % 8 == 1) & (cols == 0)) | ((rows % 8 == 5) & (cols == 9))
+    for m, n in ((mask, 4), (snake[:, :10], 1)):
+        got, count = components(m)
+        assert count == n
+        assert (got[~m] == -1).all() and set(np.unique(got[m])) == set(range(n))
+    got, _ = components(mask)
+    assert len(np.unique(got[0, :])) == 1 and got[0, 0] == got[8, 11]
+    assert got[6, 6] != got[7, 7]

@@ -1,0 +1,243 @@
+"""A band that crosses the hole: a painted lane, a strip of another floor between two.
+
+The exemplar of the hole's material (`material`) leaves out what is seen on few sides of the hole,
+which keeps clutter out but also stops a lane wider than a line at the hole's border, with the
+floor on its far side filled as the near side's. Read around the hole, such a band shows as a
+pattern of colours that nothing else makes: one side's material, the band, the other side's
+material, the band again. The two places where it meets the hole are joined by a straight strip
+of their width, and the hole's pieces on either side take their own side's material. Each piece
+and the strip are synthesised from the cells of their own colour around the hole and brought to
+the level of that colour at their border (`fill_crossing`).
+
+A stripe with the same material on both sides (a chair's two legs, a line across one floor) is
+left to the material's fill: nothing tells whether it crosses or ends under the object.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import DimredError
+from ..light.radiosity import LUMA
+from ..segmentation.masks import box_mean, components, dilate
+from .shift_map import hole_extent
+from .structure import Filled
+from .texture import CancelFn, SynthesisParams, fill_with_sources, membrane
+
+# Colour features: log luminance over 0.3, chromaticity (r, g) over 0.03. Light printed on a
+# photographed floor changes its luminance across the hole far more than its chromaticity.
+_SCALE = np.array([0.3, 0.03, 0.03])
+_CLUSTERS = 6  # colours looked for around the hole before near ones are merged
+_MERGE = 3.0  # feature distance below which two colours are one
+_BINS = 72  # directions the border is read in
+_ANNULUS = 4  # cells past the contact band where the border is read
+_MAX_BAND = _BINS // 6  # directions a band's crossing of the border spans at most
+_SIDE_SHARE = 0.7  # share of a side's directions its material must hold
+# Directions in which the border must be seen: where part of it is not (the raster's edge, a
+# wall, something else in front), a colour seen on two sides of the gap may be the material
+# itself, interrupted.
+_SEEN_SHARE = 0.9
+_CONTACT = 0.05  # of the ring's reach: the contact band left out, as `material` does
+_LEVEL_RADIUS = 2  # cells: the mean a region's own colour is taken over around the hole
+_GRAIN_RADIUS = 3  # cells: the synthesis's grain is its luminance over its mean over this square
+
+
+@dataclass(frozen=True)
+class Crossing:
+    """`regions` (h, w): per hole cell the colour label it takes (-1 elsewhere); `labels` (h, w)
+    the colour label of the known cells near the hole (-1 elsewhere); `band` the band's label."""
+
+    regions: np.ndarray
+    labels: np.ndarray
+    band: int
+
+
+def find_crossing(image: np.ndarray, known: np.ndarray, hole: np.ndarray) -> Crossing | None:
+    """The band that crosses `hole` in `image` (h, w, 3 reflectance; `known` the cells seen), or
+    None where the colours around the hole show none, or the hole's border is not seen nearly
+    all around."""
+    known = known & ~hole
+    if not hole.any() or not known.any():
+        return None
+    reach = int(np.clip(round(hole_extent(hole) / 2), 4, 32))
+    contact = max(1, round(_CONTACT * reach))
+    near = known & dilate(hole, 2 * reach)
+    ring = known & dilate(hole, reach) & ~dilate(hole, contact)
+    if ring.sum() < _CLUSTERS * 8:
+        return None
+    features = _features(image, known)
+    labels = np.full(hole.shape, -1)
+    labels[near] = _colour_labels(features[ring], features[near])
+    annulus = ring & dilate(hole, contact + _ANNULUS)
+    centre = np.array([x.mean() for x in np.nonzero(hole)])
+    directions = _directions(annulus, centre)
+    around = _border_sequence(labels, annulus, directions)
+    if (around >= 0).mean() < _SEEN_SHARE:
+        return None
+    found = _band(around)
+    if found is None:
+        return None
+    band, runs = found
+    inner = ring & dilate(hole, max(reach // 2, 4)) & (labels == band)
+    ends = [_run_cells(inner, directions, start, length) for start, length in runs]
+    if min(len(e) for e in ends) < 4:
+        return None
+    regions = np.full(hole.shape, -1)
+    regions[_strip(hole, *ends)] = band
+    pieces, count = components(hole & (regions < 0))
+    for piece in range(count):
+        cells = pieces == piece
+        beside = labels[annulus & dilate(cells, contact + _ANNULUS + 1)]
+        beside = beside[(beside >= 0) & (beside != band)]
+        if not len(beside):
+            return None  # a piece with no colour beside it: nothing to say what it continues
+        regions[cells] = np.bincount(beside).argmax()
+    return Crossing(regions=regions, labels=labels, band=band)
+
+
+def fill_crossing(crossing: Crossing, image: np.ndarray, known: np.ndarray, params: SynthesisParams, *,
+                  seed: int = 0, cancel: CancelFn | None = None) -> Filled:
+    """`image` (h, w, 3) with the crossing's regions filled, each synthesised from the `known`
+    cells of its own colour near the hole and brought to the membrane over it of those cells'
+    means (a few cells wide), its own grain (luminance over its mean) kept. A region whose colour
+    has too few cells for the synthesis (a narrow band's) takes the grain of all the cells seen;
+    one with no cell of its colour beside it, the synthesis's level. Raises `DimredError` where
+    too little is seen to synthesise at all."""
+    out = np.asarray(image, np.float32).copy()
+    sources = np.full((*known.shape, 2), -1, np.int64)
+    done = known & ~(crossing.regions >= 0)
+    labels = np.unique(crossing.regions[crossing.regions >= 0])
+    for label in sorted(labels, key=lambda k: k != crossing.band):  # the band first: the sides meet it
+        region = crossing.regions == label
+        own = done & (crossing.labels == label)
+        try:
+            got, src = fill_with_sources(out, done, region, params, exemplar=out, exemplar_valid=own, seed=seed,
+                                         cancel=cancel)
+        except DimredError:  # too few cells of this colour (a narrow band): the grain of all seen around
+            got, src = fill_with_sources(out, done, region, params, seed=seed, cancel=cancel)
+        luma = got @ LUMA
+        mean, _ = box_mean(luma[..., None], region, _GRAIN_RADIUS)
+        grain = luma / np.maximum(mean[..., 0], 1e-9)
+        out[region], sources[region] = got[region], src[region]
+        if (own & dilate(region, 2)).any():
+            level, _ = box_mean(out, own, _LEVEL_RADIUS)
+            out[region] = membrane(level, own, region)[region] * grain[region, None]
+        done = done | region
+    return Filled(out, sources, None)
+
+
+def _features(image: np.ndarray, known: np.ndarray) -> np.ndarray:
+    """(h, w, 3) log luminance and chromaticity, scaled by `_SCALE`, over 5x5 known cells."""
+    log_y = np.log(np.maximum(image @ LUMA, 1e-4))[..., None]
+    chroma = image[..., :2] / np.maximum(image.sum(axis=-1, keepdims=True), 1e-6)
+    mean, _ = box_mean(np.concatenate([log_y, chroma], axis=-1) / _SCALE, known, 2)
+    return mean
+
+
+def _colour_labels(sample: np.ndarray, cells: np.ndarray) -> np.ndarray:
+    """(N,) the label of each of `cells` (N, 3 features): its nearest colour among those k-means
+    finds in `sample`, a colour nearer than `_MERGE` to a more common one taken as that one."""
+    centres = [np.median(sample, axis=0)]
+    for _ in range(_CLUSTERS - 1):  # farthest-point start: the same colours from run to run
+        gap = np.min([np.linalg.norm(sample - c, axis=1) for c in centres], axis=0)
+        centres.append(sample[np.argmax(gap)])
+    centres = np.array(centres)
+    for _ in range(20):
+        nearest = np.argmin(((sample[:, None] - centres[None]) ** 2).sum(-1), axis=1)
+        centres = np.array([sample[nearest == k].mean(axis=0) if (nearest == k).any() else centres[k]
+                            for k in range(len(centres))])
+    # A colour joins the most common one near it, not a chain of near ones: the blends along a
+    # band's edges would chain the band to both its sides.
+    count = np.bincount(nearest, minlength=len(centres))
+    group = np.arange(len(centres))
+    for k in np.argsort(-count, kind="stable"):
+        roots = [j for j in np.argsort(-count, kind="stable") if group[j] == j and count[j] > count[k]]
+        near = [j for j in roots if np.linalg.norm(centres[k] - centres[j]) < _MERGE]
+        if near:
+            group[k] = near[0]
+    group = np.unique(group, return_inverse=True)[1]
+    return group[np.argmin(((cells[:, None] - centres[None]) ** 2).sum(-1), axis=1)]
+
+
+def _directions(cells: np.ndarray, centre: np.ndarray) -> np.ndarray:
+    """(h, w) the direction bin (0.._BINS-1) of every cell seen from `centre`."""
+    rows, cols = np.indices(cells.shape)
+    angle = np.arctan2(rows - centre[0], cols - centre[1]) + np.pi
+    return (angle / (2 * np.pi) * _BINS).astype(np.int64) % _BINS
+
+
+def _border_sequence(labels: np.ndarray, annulus: np.ndarray, directions: np.ndarray) -> np.ndarray:
+    """(_BINS,) the commonest label of the `annulus` cells in each direction (-1 where none),
+    a direction whose label differs from both its neighbours' taken as its predecessor's."""
+    counts = np.zeros((_BINS, labels.max() + 1))
+    np.add.at(counts, (directions[annulus], labels[annulus]), 1.0)
+    around = np.where(counts.sum(axis=1) > 0, counts.argmax(axis=1), -1)
+    before, after = np.roll(around, 1), np.roll(around, -1)
+    return np.where((around != before) & (around != after), before, around)
+
+
+def _runs(around: np.ndarray) -> list[tuple[int, int, int]]:
+    """The circular runs of `around`: (label, first direction, length)."""
+    starts = np.flatnonzero(around != np.roll(around, 1))
+    if not len(starts):
+        return [(int(around[0]), 0, len(around))]
+    ends = np.roll(starts, -1)
+    n = len(around)
+    return [(int(around[s]), int(s), int((e - s) % n) or n) for s, e in zip(starts, ends, strict=True)]
+
+
+def _band(around: np.ndarray) -> tuple[int, list[tuple[int, int]]] | None:
+    """The label that meets the border in exactly two short runs separating two sides held by two
+    different materials, with its runs (first direction, length); None where none does."""
+    runs = _runs(around)
+    for label in sorted({r[0] for r in runs if r[0] >= 0}):
+        mine = [(s, n) for lab, s, n in runs if lab == label]
+        if len(mine) != 2 or max(n for _, n in mine) > _MAX_BAND:
+            continue
+        sides = [_side(around, a, b) for a, b in ((mine[0], mine[1]), (mine[1], mine[0]))]
+        if None not in sides and sides[0] != sides[1]:
+            return label, mine
+    return None
+
+
+def _side(around: np.ndarray, run: tuple[int, int], next_run: tuple[int, int]) -> int | None:
+    """The label holding `_SIDE_SHARE` of the directions between `run`'s end and `next_run`'s start."""
+    first = run[0] + run[1]
+    span = np.arange(first, first + (next_run[0] - first) % len(around)) % len(around)
+    seen = around[span][around[span] >= 0]
+    if not len(seen):
+        return None
+    count = np.bincount(seen)
+    return int(count.argmax()) if count.max() >= _SIDE_SHARE * len(seen) else None
+
+
+def _run_cells(cells: np.ndarray, directions: np.ndarray, start: int, length: int) -> np.ndarray:
+    """(N, 2) the `cells` in the directions of a run, a direction of margin on each side."""
+    inside = ((directions - start + 1) % _BINS) < length + 2
+    return np.argwhere(cells & inside).astype(np.float64)
+
+
+def _strip(hole: np.ndarray, first: np.ndarray, second: np.ndarray) -> np.ndarray:
+    """(h, w) the hole cells of the straight strip joining the band's cells where it meets the
+    hole on one side (`first`, (N, 2)) to the other's, its width measured across it at each end
+    and interpolated between."""
+    a, b = first.mean(axis=0), second.mean(axis=0)
+    length = float(np.linalg.norm(b - a))
+    if length < 1e-9:
+        return np.zeros_like(hole)
+    along = (b - a) / length
+    across = np.array([-along[1], along[0]])
+    offsets, widths = [], []
+    for cells in (first, second):
+        lo, hi = np.percentile(cells @ across, [5, 95])
+        offsets.append(0.5 * (lo + hi) - a @ across)
+        widths.append(hi - lo)
+    rows, cols = np.nonzero(hole)
+    q = np.stack([rows, cols], axis=1) - a
+    t = np.clip(q @ along / length, 0.0, 1.0)
+    centre = offsets[0] * (1 - t) + offsets[1] * t
+    half = 0.5 * (widths[0] * (1 - t) + widths[1] * t)
+    out = np.zeros_like(hole)
+    out[rows, cols] = np.abs(q @ across - centre) <= half
+    return out

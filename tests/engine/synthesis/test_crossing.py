@@ -1,0 +1,93 @@
+"""A band crossing the hole between two materials is continued across it, each side with its own."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from addon.synthesis.crossing import fill_crossing, find_crossing
+from addon.synthesis.texture import SynthesisParams
+
+_H, _W = 128, 160
+_GREEN, _BROWN, _YELLOW = np.array([0.10, 0.16, 0.06]), np.array([0.16, 0.11, 0.07]), np.array([0.55, 0.42, 0.05])
+
+
+def _lane(*, far: np.ndarray = _BROWN, width: float = 7.0, slope: float = 0.35) -> tuple[np.ndarray, np.ndarray]:
+    """A floor of `_GREEN` above a straight lane of `_YELLOW` and `far` below it, grainy and lit
+    brighter to the right, and the lane's signed distance across (positive below)."""
+    rng = np.random.default_rng(4)
+    rows, cols = np.indices((_H, _W)).astype(float)
+    across = (rows - (60 + slope * (cols - 80))) / np.hypot(1.0, slope)
+    colour = np.where((across < -width / 2)[..., None], _GREEN, np.where((across > width / 2)[..., None], far, _YELLOW))
+    light = 1 + 0.3 * cols / _W
+    grain = 1 + 0.12 * rng.standard_normal((_H, _W))
+    return colour * (light * grain)[..., None], across
+
+
+def _hole() -> np.ndarray:
+    hole = np.zeros((_H, _W), bool)
+    hole[44:78, 62:100] = True
+    return hole
+
+
+def _region_means(image: np.ndarray, mask: np.ndarray) -> np.ndarray:
+    return image[mask].mean(axis=0)
+
+
+def test_a_lane_between_two_floors_runs_on_across_the_hole() -> None:
+    truth, across = _lane()
+    hole = _hole()
+    known = ~hole
+    image = np.where(hole[..., None], 0.0, truth)
+    crossing = find_crossing(image, known, hole)
+    assert crossing is not None
+    band = crossing.regions == crossing.band
+    lane = hole & (np.abs(across) < 2.0)  # the lane's middle, away from its edges
+    assert band[lane].all()
+    assert not band[hole & (np.abs(across) > 6.0)].any()
+    filled = fill_crossing(crossing, image, known, SynthesisParams(), seed=0)
+    for part in (lane, hole & (across < -6), hole & (across > 6)):  # each side its own colour and level
+        np.testing.assert_allclose(_region_means(filled.image, part), _region_means(truth, part), rtol=0.1)
+    np.testing.assert_array_equal(filled.image[known], image[known].astype(np.float32))
+    # the sides' copies come from their own colour's cells
+    src = filled.sources[hole & (across > 6)]
+    src = src[src[:, 0] >= 0]
+    assert len(src) and (across[src[:, 0], src[:, 1]] > 3.5).all()
+
+
+@pytest.mark.parametrize("case", ["same floor both sides", "checker", "plain"])
+def test_nothing_crosses_where_nothing_tells_it_does(case: str) -> None:
+    hole = _hole()
+    if case == "same floor both sides":  # a line across one floor may as well end under the object
+        image, _ = _lane(far=_GREEN)
+    elif case == "checker":
+        rows, cols = np.indices((_H, _W))
+        image = np.where((((rows // 12) + (cols // 12)) % 2 == 0)[..., None], _GREEN, _YELLOW)
+    else:
+        image, _ = _lane(far=_GREEN, width=0.0)
+    assert find_crossing(image, ~hole, hole) is None
+
+
+def test_legs_on_two_sides_of_one_floor_are_no_band() -> None:
+    image, _ = _lane(far=_GREEN, width=0.0)
+    hole = _hole()
+    legs = np.zeros((_H, _W), bool)
+    legs[20:44, 78:82] = True  # a dark leg above the hole and one below, in line
+    legs[78:104, 78:82] = True
+    image[legs] = 0.01
+    assert find_crossing(image, ~hole, hole) is None
+
+
+def test_a_band_seen_on_one_side_only_is_no_crossing() -> None:
+    truth, across = _lane()
+    hole = _hole()
+    known = ~hole & ~((np.indices((_H, _W))[1] > 100) & (np.abs(across) < 12))  # its far end unseen
+    assert find_crossing(np.where(known[..., None], truth, 0.0), known, hole) is None
+
+
+def test_a_border_not_seen_all_around_tells_no_crossing() -> None:
+    truth, _ = _lane()
+    hole = _hole()
+    rows, cols = np.indices((_H, _W))
+    known = ~hole & ~((rows < 44) & (cols >= 56) & (cols <= 106))  # the floor above the hole unseen
+    assert find_crossing(np.where(known[..., None], truth, 0.0), known, hole) is None
+    assert find_crossing(np.where(hole[..., None], 0.0, truth), ~hole, hole) is not None
