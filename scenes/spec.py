@@ -850,6 +850,42 @@ def _workshop_box() -> SceneSpec:
     )
 
 
+def _hotel_rug_box() -> SceneSpec:
+    # The hotel's floor again, a box standing half on the striped rug: the rug's straight edge runs
+    # on under it.
+    room = Room(lo=(-1.4, -1.2, 0.0), hi=(1.8, 2.4, 2.6), wall_albedo=(0.78, 0.75, 0.7),
+                floor=_photo_floor("interior.exr", height=1.5))
+    return SceneSpec(
+        name="hotel_rug_box",
+        room=room,
+        lamps=(Lamp((-0.5, 1.5), (0.3, 0.3), 30.0, (1.0, 0.9, 0.75)), Lamp((0.6, -0.6), (0.3, 0.3), 20.0)),
+        objects=(SceneObject("Box", "box", (0.4, 0.4, 0.4), _on_floor(room, -0.45, 0.3), (0.45, 0.5, 0.55),
+                             rotation_z=-29.0),),
+        probe=(0.3, 1.2, 1.5),
+        remove="Box",
+        render=_PHOTO_RENDER,
+        windows=(Window("east", (0.5, 1.4), (1.6, 1.7), 5.0, (1.0, 0.97, 0.92)),),
+    )
+
+
+def _apartment_sun_box() -> SceneSpec:
+    # The apartment's floor with the sunlit patch printed on it, a box standing on the patch's
+    # straight left edge: the edge between the bright and the plain wood runs on under it.
+    room = Room(lo=(-2.2, -2.0, 0.0), hi=(2.4, 2.4, 2.7), wall_albedo=(0.82, 0.8, 0.76),
+                floor=_photo_floor("apartment.exr"))
+    return SceneSpec(
+        name="apartment_sun_box",
+        room=room,
+        lamps=(Lamp((0.6, 1.2), (0.5, 0.5), 25.0), Lamp((-1.0, -0.8), (0.4, 0.4), 15.0)),
+        objects=(SceneObject("Box", "box", (0.35, 0.35, 0.35), _on_floor(room, -0.73, -1.6), (0.3, 0.3, 0.32),
+                             rotation_z=20.0),),
+        probe=(0.0, 0.0, 1.6),
+        remove="Box",
+        render=_PHOTO_RENDER,
+        windows=(Window("south", (0.4, 1.35), (1.4, 1.7), 5.0),),
+    )
+
+
 PHOTO_SPECS: dict[str, SceneSpec] = {s.name: s for s in (
     _hotel_box(),
     _hotel_chair(),
@@ -858,6 +894,8 @@ PHOTO_SPECS: dict[str, SceneSpec] = {s.name: s for s in (
     _lobby_stool(),
     _warehouse_box(),
     _workshop_box(),
+    _hotel_rug_box(),
+    _apartment_sun_box(),
 )}
 
 

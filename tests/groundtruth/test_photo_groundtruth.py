@@ -18,7 +18,7 @@ from test_removal_groundtruth import _remove
 from scenes import metrics as M
 from scenes import spec as S
 
-SCENES = ["hotel_box", "hotel_walls", "apartment_chair", "workshop_box"]
+SCENES = ["hotel_box", "hotel_walls", "apartment_chair", "workshop_box", "hotel_rug_box", "apartment_sun_box"]
 SIZE = {"width": 256, "height": 128, "samples": 32}
 BOUNDS = M.CLEAN_REMOVAL_BOUNDS  # figure: (lowest, highest) it may take
 # (scene, figure): what the engine measured where it fails the bound (256x128). Of each total,
@@ -56,6 +56,19 @@ FAILING: dict[tuple[str, str], str] = {
     # median 0.91 and the worst draw 0.75 (bench_photo_stability).
     ("workshop_box", "total"): "measured 0.294",
     ("workshop_box", "detail"): "measured 0.705",
+    # The rug's striped band passes under the box between the bed's olive cover and the wood.
+    # Around the hole the bed and the wood read as one colour (their chromaticities within
+    # 0.04), so no band between two materials is found (`crossing`), and the rug, seen on one
+    # side, is left out as clutter: the hole is filled with wood where the truth shows the rug's
+    # black and white stripes, too bright and too smooth.
+    ("hotel_rug_box", "total"): "measured 0.669",
+    ("hotel_rug_box", "mean_error"): "measured 0.390",
+    ("hotel_rug_box", "detail"): "measured 0.367",
+    # The sunlit patch printed on the floor is continued under the box by the material's fill
+    # (within all the bounds at 512x256 and 128 samples: mean error 0.019, total 0.140); at this
+    # size the hole is a few dozen cells and the fill a little too dark.
+    ("apartment_sun_box", "total"): "measured 0.234",
+    ("apartment_sun_box", "mean_error"): "measured 0.066",
 }
 
 
