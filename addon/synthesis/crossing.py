@@ -66,15 +66,15 @@ def find_crossing(image: np.ndarray, known: np.ndarray, hole: np.ndarray) -> Cro
     ring = known & dilate(hole, reach) & ~dilate(hole, contact)
     if ring.sum() < _CLUSTERS * 8:
         return None
-    features = _features(image, known)
-    labels = np.full(hole.shape, -1)
-    labels[near] = _colour_labels(features[ring], features[near])
     annulus = ring & dilate(hole, contact + _ANNULUS)
     centre = np.array([x.mean() for x in np.nonzero(hole)])
     directions = _directions(annulus, centre)
+    if (_border_sequence(annulus.astype(np.int64) - 1, annulus, directions) >= 0).mean() < _SEEN_SHARE:
+        return None  # decided before the colours are: most holes on a floor's edge end here
+    features = _features(image, known)
+    labels = np.full(hole.shape, -1)
+    labels[near] = _colour_labels(features[ring], features[near])
     around = _border_sequence(labels, annulus, directions)
-    if (around >= 0).mean() < _SEEN_SHARE:
-        return None
     found = _band(around)
     if found is None:
         return None
