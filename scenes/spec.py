@@ -725,11 +725,20 @@ def _photo_floor(source: str, **projection: Any) -> Floor:
     return Floor("photo", photo=Photo(source, **projection))
 
 
-def _hotel_box() -> SceneSpec:
-    # Blender's hotel room: the curtained window is at +x in the photograph, and so here; a
-    # 0.5 m box on the wood between the striped rug and the desk chair's foot.
-    room = Room(lo=(-1.4, -1.2, 0.0), hi=(1.8, 2.4, 2.6), wall_albedo=(0.78, 0.75, 0.7),
+def _hotel_room() -> Room:
+    # Blender's hotel room: the curtained window is at +x in the photograph, and so here.
+    return Room(lo=(-1.4, -1.2, 0.0), hi=(1.8, 2.4, 2.6), wall_albedo=(0.78, 0.75, 0.7),
                 floor=_photo_floor("interior.exr", height=1.5))
+
+
+def _apartment_room() -> Room:
+    return Room(lo=(-2.2, -2.0, 0.0), hi=(2.4, 2.4, 2.7), wall_albedo=(0.82, 0.8, 0.76),
+                floor=_photo_floor("apartment.exr"))
+
+
+def _hotel_box() -> SceneSpec:
+    # A 0.5 m box on the wood between the striped rug and the desk chair's foot.
+    room = _hotel_room()
     return SceneSpec(
         name="hotel_box",
         room=room,
@@ -744,8 +753,7 @@ def _hotel_box() -> SceneSpec:
 
 
 def _hotel_chair() -> SceneSpec:
-    room = Room(lo=(-1.4, -1.2, 0.0), hi=(1.8, 2.4, 2.6), wall_albedo=(0.78, 0.75, 0.7),
-                floor=_photo_floor("interior.exr", height=1.5))
+    room = _hotel_room()
     # The same floor seen from elsewhere, a dark chair with its back to the window, a sun patch.
     return SceneSpec(
         name="hotel_chair",
@@ -782,8 +790,7 @@ def _hotel_walls() -> SceneSpec:
 def _apartment_chair() -> SceneSpec:
     # The empty apartment's wood floor with its sunlit patch, the window in the south wall where
     # the photograph's is; a light chair turned towards the room.
-    room = Room(lo=(-2.2, -2.0, 0.0), hi=(2.4, 2.4, 2.7), wall_albedo=(0.82, 0.8, 0.76),
-                floor=_photo_floor("apartment.exr"))
+    room = _apartment_room()
     return SceneSpec(
         name="apartment_chair",
         room=room,
@@ -853,8 +860,7 @@ def _workshop_box() -> SceneSpec:
 def _hotel_rug_box() -> SceneSpec:
     # The hotel's floor again, a box standing half on the striped rug: the rug's straight edge runs
     # on under it.
-    room = Room(lo=(-1.4, -1.2, 0.0), hi=(1.8, 2.4, 2.6), wall_albedo=(0.78, 0.75, 0.7),
-                floor=_photo_floor("interior.exr", height=1.5))
+    room = _hotel_room()
     return SceneSpec(
         name="hotel_rug_box",
         room=room,
@@ -871,8 +877,7 @@ def _hotel_rug_box() -> SceneSpec:
 def _apartment_sun_box() -> SceneSpec:
     # The apartment's floor with the sunlit patch printed on it, a box standing on the patch's
     # straight left edge: the edge between the bright and the plain wood runs on under it.
-    room = Room(lo=(-2.2, -2.0, 0.0), hi=(2.4, 2.4, 2.7), wall_albedo=(0.82, 0.8, 0.76),
-                floor=_photo_floor("apartment.exr"))
+    room = _apartment_room()
     return SceneSpec(
         name="apartment_sun_box",
         room=room,
