@@ -46,7 +46,8 @@ class Params:
     synth_levels: int = 0  # pyramid levels of the synthesis, 0 = from the hole's size
     synth_generations: int = 2  # synthesis passes per level: more settle seams, slower
     # compose tiled and planked floors from shifted copies of the visible floor first, so that
-    # their lines run on through the hole; False leaves all to the per-pixel synthesis
+    # their lines run on through the hole, and continue a band that crosses the hole between two
+    # materials (a painted lane); False leaves all to the per-pixel synthesis
     synth_structure: bool = True
     seed: int = 0  # the synthesis's random seed: the same seed gives the same fill
     # where the removal brightens a surface (its shadow), weigh the photograph's detail down as

@@ -24,7 +24,7 @@ _DEFAULTS = Params()
 
 # Settings that override the preset's engine parameter of the same name (addon.quality.Params).
 OVERRIDABLE = ("patches", "max_senders", "max_bounces", "working_width", "raster_cell", "synth_neighbourhood",
-               "synth_generations", "seed", "insertion_passes")
+               "synth_generations", "synth_structure", "seed", "insertion_passes")
 
 
 def _is_mesh(_settings: bpy.types.PropertyGroup, obj: bpy.types.Object) -> bool:
@@ -214,6 +214,11 @@ class DimredSettings(bpy.types.PropertyGroup):
         name="Generations", min=1, soft_max=6, default=_DEFAULTS.synth_generations,
         description="Synthesis passes per pyramid level: more settle the seams, slower",
     )
+    synth_structure: BoolProperty(
+        name="Structure", default=_DEFAULTS.synth_structure,
+        description="Run tile and plank lines on through the fill, and continue a band that crosses the object "
+                    "between two materials (a painted lane) as a straight strip; off: texture synthesis alone",
+    )
     seed: IntProperty(
         name="Seed", min=0, default=_DEFAULTS.seed,
         description="Random seed of the fill: the same seed gives the same result, another seed another fill",
@@ -248,7 +253,7 @@ class DimredSettings(bpy.types.PropertyGroup):
         options={'HIDDEN'},
     )
 
-    def overrides(self) -> dict[str, float | int]:
+    def overrides(self) -> dict[str, float | int | bool]:
         """The engine parameters set here, when they override the preset (else none)."""
         if not self.override_parameters:
             return {}

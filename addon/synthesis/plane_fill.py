@@ -97,7 +97,9 @@ class FillOptions:
     margin: float
     synthesis: SynthesisParams
     seed: int = 0
-    structure: bool = True  # compose tiled and planked floors from shifted copies first (`structure`)
+    # compose tiled and planked floors from shifted copies first (`structure`), and continue a band
+    # that crosses the hole between two materials (`crossing`)
+    structure: bool = True
 
 
 @dataclass(frozen=True)
@@ -147,7 +149,7 @@ def fill_surface(
     # photograph shows on it beside the hole (a door, a dark panel) is no clutter to leave out.
     wall = planeraster.is_wall(plane.normal)
     material = wall_material(known) if wall else border_material(values, known, hole, min_cells=_MIN_KNOWN)
-    crossing = None if wall else find_crossing(values, known, hole)
+    crossing = find_crossing(values, known, hole) if options.structure and not wall else None
     if crossing is not None:  # each colour is copied only into its own region: nothing to repaint
         material = replace(material, replaced=np.zeros_like(material.replaced))
     # Only the hole's own material is copied; other things seen beside the hole (the object's

@@ -125,3 +125,30 @@ def test_seams_thinner_than_a_pixel_darken_the_hidden_pixels_on_them(monkeypatch
     correlation = np.corrcoef(profiled, truth)[0, 1]
     assert correlation > 0.9 and correlation > np.corrcoef(interpolated, truth)[0, 1] + 0.3
     assert profiled[on_seam].mean() < 0.25 and abs(profiled.mean() / truth.mean() - 1) < 0.05
+
+
+def test_a_lane_between_two_floors_runs_on_under_the_lid_unless_structure_is_off():
+    """A yellow lane between a green floor and a brown one crosses the hidden floor: with the
+    structure-aware fill it is continued as a strip (`crossing`), the floors on its sides each
+    their own; without it, the material's fill alone decides."""
+    panorama_maps, _, valid, floor, _ = setup()
+    s_with, d_with = panorama_maps.surface_with, panorama_maps.distance_with
+    centre = floor.points.mean(axis=0)
+    direction = np.array([np.cos(0.4), np.sin(0.4), 0.0])
+
+    def lane_rho(points):
+        across = (points - centre) @ np.array([-direction[1], direction[0], 0.0])
+        green, yellow, brown = np.array([0.10, 0.16, 0.06]), np.array([0.55, 0.42, 0.05]), np.array([0.16, 0.11, 0.07])
+        return np.where((across < -0.03)[..., None], green, np.where((across > 0.03)[..., None], brown, yellow))
+
+    points = latlong.pixel_directions(WIDTH, WIDTH // 2) * d_with[..., None]
+    panorama = PanoramaReflectance(lane_rho(points), valid & (s_with == 0), panorama_maps)
+    options = FillOptions(cell=0.01, margin=1.5, synthesis=SynthesisParams())
+    got = fill_surface(panorama, floor, options)
+    assert got.band_cells > 0
+    truth = lane_rho(floor.points)
+    error = np.abs(got.rho - truth).sum(axis=1) / truth.sum(axis=1)
+    assert np.median(error) < 0.1
+    off = fill_surface(panorama, floor, FillOptions(cell=0.01, margin=1.5, synthesis=SynthesisParams(),
+                                                    structure=False))
+    assert off.band_cells == 0
