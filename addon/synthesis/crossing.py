@@ -21,7 +21,7 @@ import numpy as np
 from ..errors import DimredError
 from ..light.radiosity import LUMA
 from ..segmentation.masks import box_mean, components, dilate
-from .shift_map import hole_extent
+from .material import colour_features, direction_bins, log_luminance, ring_widths
 from .structure import Filled
 from .texture import CancelFn, SynthesisParams, fill_with_sources, membrane
 
@@ -38,7 +38,6 @@ _SIDE_SHARE = 0.7  # share of a side's directions its material must hold
 # wall, something else in front), a colour seen on two sides of the gap may be the material
 # itself, interrupted.
 _SEEN_SHARE = 0.9
-_CONTACT = 0.05  # of the ring's reach: the contact band left out, as `material` does
 _LEVEL_RADIUS = 2  # cells: the mean a region's own colour is taken over around the hole
 _GRAIN_RADIUS = 3  # cells: the synthesis's grain is its luminance over its mean over this square
 
@@ -52,6 +51,11 @@ class Crossing:
     labels: np.ndarray
     band: int
 
+    @property
+    def band_cells(self) -> int:
+        """The hole cells of the band's strip."""
+        return int((self.regions == self.band).sum())
+
 
 def find_crossing(image: np.ndarray, known: np.ndarray, hole: np.ndarray) -> Crossing | None:
     """The band that crosses `hole` in `image` (h, w, 3 reflectance; `known` the cells seen), or
@@ -60,18 +64,17 @@ def find_crossing(image: np.ndarray, known: np.ndarray, hole: np.ndarray) -> Cro
     known = known & ~hole
     if not hole.any() or not known.any():
         return None
-    reach = int(np.clip(round(hole_extent(hole) / 2), 4, 32))
-    contact = max(1, round(_CONTACT * reach))
+    reach, contact = ring_widths(hole)
     near = known & dilate(hole, 2 * reach)
     ring = known & dilate(hole, reach) & ~dilate(hole, contact)
     if ring.sum() < _CLUSTERS * 8:
         return None
     annulus = ring & dilate(hole, contact + _ANNULUS)
-    centre = np.array([x.mean() for x in np.nonzero(hole)])
-    directions = _directions(annulus, centre)
+    centre = tuple(float(x.mean()) for x in np.nonzero(hole))
+    directions = direction_bins(*np.indices(hole.shape), centre, _BINS)
     if (_border_sequence(annulus.astype(np.int64) - 1, annulus, directions) >= 0).mean() < _SEEN_SHARE:
         return None  # decided before the colours are: most holes on a floor's edge end here
-    features = _features(image, known)
+    features = colour_features(image, log_luminance(image), known, radius=2) / _SCALE
     labels = np.full(hole.shape, -1)
     labels[near] = _colour_labels(features[ring], features[near])
     around = _border_sequence(labels, annulus, directions)
@@ -127,14 +130,6 @@ def fill_crossing(crossing: Crossing, image: np.ndarray, known: np.ndarray, para
     return Filled(out, sources, None)
 
 
-def _features(image: np.ndarray, known: np.ndarray) -> np.ndarray:
-    """(h, w, 3) log luminance and chromaticity, scaled by `_SCALE`, over 5x5 known cells."""
-    log_y = np.log(np.maximum(image @ LUMA, 1e-4))[..., None]
-    chroma = image[..., :2] / np.maximum(image.sum(axis=-1, keepdims=True), 1e-6)
-    mean, _ = box_mean(np.concatenate([log_y, chroma], axis=-1) / _SCALE, known, 2)
-    return mean
-
-
 def _colour_labels(sample: np.ndarray, cells: np.ndarray) -> np.ndarray:
     """(N,) the label of each of `cells` (N, 3 features): its nearest colour among those k-means
     finds in `sample`, a colour nearer than `_MERGE` to a more common one taken as that one."""
@@ -151,20 +146,14 @@ def _colour_labels(sample: np.ndarray, cells: np.ndarray) -> np.ndarray:
     # band's edges would chain the band to both its sides.
     count = np.bincount(nearest, minlength=len(centres))
     group = np.arange(len(centres))
-    for k in np.argsort(-count, kind="stable"):
-        roots = [j for j in np.argsort(-count, kind="stable") if group[j] == j and count[j] > count[k]]
+    commonest = np.argsort(-count, kind="stable")
+    for k in commonest:
+        roots = [j for j in commonest if group[j] == j and count[j] > count[k]]
         near = [j for j in roots if np.linalg.norm(centres[k] - centres[j]) < _MERGE]
         if near:
             group[k] = near[0]
     group = np.unique(group, return_inverse=True)[1]
     return group[np.argmin(((cells[:, None] - centres[None]) ** 2).sum(-1), axis=1)]
-
-
-def _directions(cells: np.ndarray, centre: np.ndarray) -> np.ndarray:
-    """(h, w) the direction bin (0.._BINS-1) of every cell seen from `centre`."""
-    rows, cols = np.indices(cells.shape)
-    angle = np.arctan2(rows - centre[0], cols - centre[1]) + np.pi
-    return (angle / (2 * np.pi) * _BINS).astype(np.int64) % _BINS
 
 
 def _border_sequence(labels: np.ndarray, annulus: np.ndarray, directions: np.ndarray) -> np.ndarray:

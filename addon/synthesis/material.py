@@ -77,15 +77,13 @@ def border_material(image: np.ndarray, known: np.ndarray, hole: np.ndarray, *, m
                          decided=False)
     if not hole.any():
         return undecided
-    reach = int(np.clip(round(hole_extent(hole) / 2), 4, 32))
+    reach, contact = ring_widths(hole)
     near = dilate(hole, reach) & ~hole
     inner = dilate(hole, reach // 2)
     if not (known & near).any():
         return undecided
-    log_y = np.log(np.maximum(image @ LUMA, 1e-4))
-    mean, _ = box_mean(np.concatenate([log_y[..., None],
-                                       image[..., :2] / np.maximum(image.sum(axis=-1, keepdims=True), 1e-6)],
-                                      axis=-1), known, 1)
+    log_y = log_luminance(image)
+    mean = colour_features(image, log_y, known, radius=1)
     bins = np.floor(mean / _STEPS).astype(np.int64)
     lo = bins[known].min(axis=0)
     shape = tuple(bins[known].max(axis=0) - lo + 1)
@@ -97,7 +95,7 @@ def border_material(image: np.ndarray, known: np.ndarray, hole: np.ndarray, *, m
     # printed on a photographed floor shifts its shade from the band to the ring). A hole across
     # several materials (a painted line between two floors) matches none all round in the band:
     # the ring beyond decides alone then, with the band (the contact shadow, the legs) left out.
-    rings = ((known & inner & ~dilate(hole, max(1, round(_CONTACT * reach))), _AROUND[:1]),
+    rings = ((known & inner & ~dilate(hole, contact), _AROUND[:1]),
              (known & near & ~inner, _AROUND))
     found, last = [], None
     everywhere = np.zeros_like(known)  # colours found all around the hole, in either ring
@@ -143,6 +141,32 @@ def border_material(image: np.ndarray, known: np.ndarray, hole: np.ndarray, *, m
                     share=float(exemplar.sum() / known.sum()))
 
 
+def ring_widths(hole: np.ndarray) -> tuple[int, int]:
+    """The cells around `hole` (non-empty) whose colours tell its material: how far the ring
+    reaches (half the hole's extent, 4-32 cells), and how wide its contact band is (the object's
+    contact shadow and legs, right at the hole), which is left out."""
+    reach = int(np.clip(round(hole_extent(hole) / 2), 4, 32))
+    return reach, max(1, round(_CONTACT * reach))
+
+
+def log_luminance(image: np.ndarray) -> np.ndarray:
+    """(h, w) the log luminance of `image` (h, w, 3), from 1e-4 up."""
+    return np.log(np.maximum(image @ LUMA, 1e-4))
+
+
+def colour_features(image: np.ndarray, log_y: np.ndarray, known: np.ndarray, *, radius: int) -> np.ndarray:
+    """(h, w, 3) `log_y` (`log_luminance` of `image`) and the chromaticity (r, g) of `image`, each
+    the mean over the `known` cells within `radius`."""
+    chroma = image[..., :2] / np.maximum(image.sum(axis=-1, keepdims=True), 1e-6)
+    mean, _ = box_mean(np.concatenate([log_y[..., None], chroma], axis=-1), known, radius)
+    return mean
+
+
+def direction_bins(rows: np.ndarray, cols: np.ndarray, centre: tuple[float, float], count: int) -> np.ndarray:
+    """The direction (0..count-1) in which each cell (rows, cols) lies seen from `centre`."""
+    return ((np.arctan2(rows - centre[0], cols - centre[1]) + np.pi) / (2 * np.pi) * count).astype(np.int64) % count
+
+
 def wall_material(known: np.ndarray) -> Material:
     """A wall's exemplar: every `known` cell, nothing repainted. What stands on a wall beside the
     hole (a door, its frame) is continued into it along the wall's columns (`wall_columns`)."""
@@ -163,9 +187,9 @@ def _directions(flat: np.ndarray, shape: tuple[int, ...], ring: np.ndarray, cent
     `ring`) in which its colour (bin `flat` (h, w) of a grid of `shape`) is present in `ring`;
     None where the ring covers too few directions or cells to tell a material apart."""
     rows, cols = np.nonzero(ring)
-    sector = ((np.arctan2(rows - centre[0], cols - centre[1]) + np.pi) / (2 * np.pi) * _SECTORS).astype(np.int64)
+    sector = direction_bins(rows, cols, centre, _SECTORS)
     counts = np.zeros((int(np.prod(shape)), _SECTORS))
-    np.add.at(counts, (flat[rows, cols], sector % _SECTORS), 1.0)
+    np.add.at(counts, (flat[rows, cols], sector), 1.0)
     per_sector = counts.sum(axis=0)
     counted = per_sector >= _MIN_SECTOR_CELLS
     if counted.sum() < _MIN_SECTORS or per_sector.sum() < _MIN_RING_CELLS:

@@ -17,7 +17,7 @@ from ..errors import DimredError
 from ..geometry import latlong, planeraster
 from ..light.radiosity import LUMA
 from ..segmentation.masks import box_mean
-from .crossing import Crossing, fill_crossing, find_crossing
+from .crossing import fill_crossing, find_crossing
 from .lines import sharpened_across
 from .material import Material, border_material, wall_material
 from .plank_profile import PlankProfile, fold_profile
@@ -183,11 +183,7 @@ def fill_surface(
     return SurfaceFill(rho=rho, raster_shape=raster.shape, cell=raster.cell, known_cells=int(known.sum()),
                        hole_cells=int(to_fill.sum()), synthesised=filled is not None,
                        structured=0 if structure is None else int(structure.covered.sum()), material=material,
-                       band_cells=_band_cells(crossing) if filled is not None else 0)
-
-
-def _band_cells(crossing: Crossing | None) -> int:
-    return 0 if crossing is None else int((crossing.regions == crossing.band).sum())
+                       band_cells=crossing.band_cells if crossing is not None and filled is not None else 0)
 
 
 def _sharpened_lines(filled: Filled) -> np.ndarray:

@@ -97,7 +97,5 @@ def _case(name: str, figure: str) -> pytest.param:
 @pytest.mark.slow
 @pytest.mark.parametrize(("name", "figure"), [_case(n, f) for n in SCENES for f in BOUNDS])
 def test_photo_textured_removal_within_bounds(name: str, figure: str, scores) -> None:
-    value = scores(name)[figure]
-    low, high = BOUNDS[figure]
-    assert (low is None or value >= low) and (high is None or value <= high), \
-        f"{name}: {figure} {value:.3f} outside [{low}, {high}]"
+    assert M.within_bounds(scores(name), (figure,)), \
+        f"{name}: {figure} {scores(name)[figure]:.3f} outside {M.bounds_text((figure,))}"
