@@ -6,7 +6,10 @@ Prints a markdown table of `scenes.metrics.clean_removal_scores`: light error (b
 renders' noise floor, `scenes.metrics.noise_floor`, as bench_removal gives it), fill structure,
 detail, fill mean error, total (object + shadow error left), the mean error and total of the
 truth's own neighbouring patch pasted over the object (`scenes.metrics.neighbour_patch_scores`:
-a plausible surface that is not the hidden one, under exactly the right light), far damage,
+a plausible surface that is not the hidden one, under exactly the right light), the floor's paint
+under the object over its paint around it (`scenes.printed.printed_level`: how far from the
+level around the hole the truth's hidden floor lies, which no fill drawn from the panorama
+can know unless it continues a structure, such as a band or a sunlit patch), far damage,
 bruise share (hidden pixels darker than 0.8 x the clean surface's 1st percentile), then the surfaces filled and the
 source of their exemplars where the report names it (`filled_surfaces`), and the seconds.
 The table goes to docs/results/bench_photo_groundtruth.md. out/photo_gt/<scene>.png shows the
@@ -69,10 +72,12 @@ def main() -> None:
     from addon.pipeline import remove_object
     from scenes import metrics
     from scenes.images import write_png
+    from scenes.printed import printed_level
 
     OUT.mkdir(parents=True, exist_ok=True)
     table = Table(["scene", "photo", "object", "light", "noise floor", "structure", "detail", "mean error", "total",
-                   "neighbour mean / total", "far damage", "bruise share", "filled (source)", "seconds"],
+                   "neighbour mean / total", "printed under / around", "far damage", "bruise share", "filled (source)",
+                   "seconds"],
                   title=f"{args.width}x{args.width // 2} at {args.samples} samples, balanced, exact proxies")
     for gt in ground_truths(args):
         s = gt.spec
@@ -84,7 +89,7 @@ def main() -> None:
         table.row(s.name, s.room.floor.photo.source, s.removed_object().kind, f"{f['light']:.3f}",
                   f"{metrics.noise_floor(gt.input, gt.truth, gt.mask):.3f}", f"{f['structure']:.3f}",
                   f"{f['detail']:.2f}", f"{f['mean_error']:.3f}", f"{f['total']:.3f}",
-                  f"{n['mean_error']:.3f} / {n['total']:.3f}",
+                  f"{n['mean_error']:.3f} / {n['total']:.3f}", f"{printed_level(s, gt.scene, gt.mask):.2f}",
                   f"{f['far_damage']:.3f}", f"{f['bruise_share']:.3f}", _sources(r.report),
                   f"{r.report['seconds']['total']:.1f}")
     write(table, notes=[f"Bounds (issue 33): {metrics.bounds_text()}"])
