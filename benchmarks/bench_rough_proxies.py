@@ -2,9 +2,10 @@
 
 The render of each scene used the exact object; for each case the pair's scene.blend is copied
 with the proxy off by the case (`scenes.perturb`: a shift in x/y, a turn about the vertical, a
-uniform scale, a floor modelled too high) and the object removed through `python -m addon.cli
-remove`, with `--cli-args` appended (e.g. "--align"). Columns, against the Cycles render without
-the object: total (`object_shadow_ratio`, the error left over the object and its shadow), lighting
+uniform scale, a floor modelled too high, or the object's bounding box for it: a box for a
+chair) and the object removed through `python -m addon.cli remove`, with `--cli-args` appended
+(e.g. "--align"). Columns, against the Cycles render without the object: total
+(`object_shadow_ratio`, the error left over the object and its shadow), lighting
 (`lighting_error_ratio`), ghost (`ghost_share`, the object's pixels left visibly wrong), far
 damage, pixels with a NaN, the command's seconds, and, where the report holds an alignment, the
 pose error it leaves (`pose_error`). Each case's row gives its difference to the scene's exact
@@ -31,7 +32,7 @@ from scenes.render import render_pair
 
 SCENES = ("basic_box", "wall_contact", "stool", "red_box", "far_dark_box", "tall_cabinet", "warm_cylinder")
 CASES = ("exact", "shift 2 cm x", "shift 2 cm y", "shift 5 cm at 45 deg", "turn 5 deg", "turn -5 deg", "scale 0.95",
-         "scale 1.05", "floor +1 cm", "shift 3 cm at 45 deg + turn 3 deg + scale 0.97")
+         "scale 1.05", "floor +1 cm", "shift 3 cm at 45 deg + turn 3 deg + scale 0.97", "box")
 COLUMNS = ("scene", "case", "total", "Δ total", "lighting", "Δ lighting", "ghost", "Δ ghost", "far", "NaN", "s",
            "pose left (cm, deg, %)", "failure")
 SCORES = ("total", "lighting", "ghost")

@@ -8,8 +8,9 @@ scores the edit against the pair's truth. `pose_error` says how far an alignment
 leaves the proxy from the exact pose.
 
 A `ProxyError`'s `name` is also its spelling on a command line (`parse` reads it back):
-"exact", "shift 2 cm x", "shift 5 cm at 45 deg", "turn -5 deg", "scale 0.95", "floor +1 cm",
-and combinations joined by " + ".
+"exact", "box" (the object's bounding box stands for it: a box modelled for an armchair),
+"shift 2 cm x", "shift 5 cm at 45 deg", "turn -5 deg", "scale 0.95", "floor +1 cm", and
+combinations joined by " + ".
 """
 from __future__ import annotations
 
@@ -49,11 +50,12 @@ class ProxyError:
     turn: float = 0.0
     scale: float = 1.0
     floor: float = 0.0
+    box: bool = False  # the proxy is the object's bounding box in its own frame ("a box for an armchair")
 
     @property
     def name(self) -> str:
         """Short label, e.g. "shift 5 cm at 45 deg + turn 3 deg"; "exact" when nothing is off."""
-        parts = []
+        parts = ["box"] if self.box else []
         x, y = self.shift
         if x or y:
             if abs(y) <= _AXIS_TOLERANCE * abs(x):
@@ -90,11 +92,15 @@ def parse(label: str) -> ProxyError:
     for part in label.strip().split(" + "):
         if part == "exact":
             continue
+        if part == "box" and "box" not in fields:
+            fields["box"] = True
+            continue
         kind = part.split(" ", 1)[0]
         match = _PARTS[kind].fullmatch(part) if kind in _PARTS and kind not in fields else None
         if match is None:
-            raise ValueError(f"cannot read {part!r} in {label!r}: expected 'exact' or parts such as 'shift 2 cm x', "
-                             "'shift 5 cm y', 'shift 5 cm at 45 deg', 'turn -5 deg', 'scale 0.95', 'floor +1 cm'")
+            raise ValueError(f"cannot read {part!r} in {label!r}: expected 'exact' or parts such as 'box', "
+                             "'shift 2 cm x', 'shift 5 cm y', 'shift 5 cm at 45 deg', 'turn -5 deg', 'scale 0.95', "
+                             "'floor +1 cm'")
         value = float(match[1])
         if kind == "shift":
             metres, a = value / 100.0, math.radians(float(match[4] or 0.0))
@@ -152,7 +158,8 @@ class PerturbedBlend:
 def perturbed_blend(blend: str | Path, object_name: str, error: ProxyError, out_blend: str | Path, *,
                     timeout: float | None = 300.0) -> PerturbedBlend:
     """Write `out_blend`: `blend` with object `object_name` moved by `error_matrix` (and, for
-    `error.floor`, the object "Floor" raised by it). Runs Blender in a subprocess
+    `error.floor`, the object "Floor" raised by it; for `error.box`, its mesh first replaced by
+    its bounding box in its own frame). Runs Blender in a subprocess
     (`scenes.perturb_job`) so that its state stays out of the caller; raises `RuntimeError`
     with the end of the job's output when it fails."""
     out_blend = Path(out_blend).resolve()

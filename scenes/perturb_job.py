@@ -1,8 +1,9 @@
 """The subprocess behind `scenes.perturb.perturbed_blend`, so that Blender's state stays out of
 the caller (its own module, so that the render cache keys, which hash `render_job.py`, stay).
 
-`python -m scenes.perturb_job BLEND OBJECT ERROR_JSON OUT_BLEND RESULT_JSON` opens BLEND, moves
-OBJECT by the error's matrix about its bottom centre (world bounding box of its mesh), raises
+`python -m scenes.perturb_job BLEND OBJECT ERROR_JSON OUT_BLEND RESULT_JSON` opens BLEND, for a
+`box` error replaces OBJECT's mesh by its bounding box in its own frame, moves OBJECT by the
+error's matrix about its bottom centre (world bounding box of its exact mesh), raises
 the object "Floor" by the error's `floor`, saves the copy OUT_BLEND (relative paths remapped, so
 it still shows the pair's panorama) and writes RESULT_JSON: the exact proxy's `bottom_centre`
 and `exact_matrix`.
@@ -32,6 +33,18 @@ def _moved(obj: bpy.types.Object, e: np.ndarray) -> None:
     obj.matrix_world = Matrix((e @ np.array(obj.matrix_world)).tolist())
 
 
+def _bounding_box_mesh(obj: bpy.types.Object) -> bpy.types.Mesh:
+    """A new mesh: the six faces, turned outwards, of `obj`'s bounding box in its own frame."""
+    lo = np.array([min(c) for c in zip(*obj.bound_box, strict=True)])
+    hi = np.array([max(c) for c in zip(*obj.bound_box, strict=True)])
+    corners = [(x, y, z) for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])]
+    faces = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
+    mesh = bpy.data.meshes.new(f"{obj.name}.box")
+    mesh.from_pydata([tuple(map(float, c)) for c in corners], [], faces)
+    mesh.update()
+    return mesh
+
+
 def run(blend: Path, object_name: str, error: ProxyError, out_blend: Path, result: Path) -> None:
     bpy.ops.wm.open_mainfile(filepath=str(blend))
     obj = bpy.data.objects.get(object_name)
@@ -44,6 +57,8 @@ def run(blend: Path, object_name: str, error: ProxyError, out_blend: Path, resul
     lo, hi = points.min(axis=0), points.max(axis=0)
     bottom = [float(lo[0] + hi[0]) / 2, float(lo[1] + hi[1]) / 2, float(lo[2])]
     exact = np.array(obj.matrix_world)
+    if error.box:
+        obj.data = _bounding_box_mesh(obj)
     _moved(obj, error_matrix(error, bottom))
     if error.floor:
         lift = np.eye(4)

@@ -65,9 +65,11 @@ def test_names_read_back() -> None:
     assert ProxyError(shift=(0.0, -0.02)).name == "shift -2 cm y"
     assert parse("shift 5 cm at 45 deg").shift == pytest.approx((0.05 / math.sqrt(2),) * 2)
     assert parse("floor +1 cm").floor == pytest.approx(0.01)
-    for label in [*CASES, "shift 3 cm at 45 deg + turn 3 deg + scale 0.97", "shift 4 cm at -120 deg + floor -0.5 cm"]:
+    assert parse("box") == ProxyError(box=True) and parse("shift 2 cm x + box").name == "box + shift 2 cm x"
+    for label in [*CASES, "shift 3 cm at 45 deg + turn 3 deg + scale 0.97", "shift 4 cm at -120 deg + floor -0.5 cm",
+                  "box + turn 5 deg"]:
         assert parse(label).name == label
-    for bad in ("shift 2 cm z", "turn 5", "scale 0.9 + scale 1.1", "wobble 3 deg"):
+    for bad in ("shift 2 cm z", "turn 5", "scale 0.9 + scale 1.1", "wobble 3 deg", "box + box"):
         with pytest.raises(ValueError, match="cannot read"):
             parse(bad)
 
@@ -114,9 +116,11 @@ for path in sys.argv[2:]:
     obj = bpy.data.objects[sys.argv[1]]
     co = np.array([obj.matrix_world @ v.co for v in obj.data.vertices])
     env = next(n for n in bpy.context.scene.world.node_tree.nodes if n.bl_idname == "ShaderNodeTexEnvironment")
+    local = np.array([tuple(c) for c in obj.bound_box])
     res.append(dict(matrix=[list(r) for r in obj.matrix_world], lo=co.min(0).tolist(), hi=co.max(0).tolist(),
                     turn=obj.rotation_euler.z, floor=list(bpy.data.objects["Floor"].location),
-                    image=bpy.path.abspath(env.image.filepath)))
+                    image=bpy.path.abspath(env.image.filepath), vertices=len(obj.data.vertices),
+                    local_lo=local.min(0).tolist(), local_hi=local.max(0).tolist()))
 print(json.dumps(res))
 """
 
@@ -179,6 +183,22 @@ def test_perturbed_blend_moves_the_proxy_by_the_error(tmp_path) -> None:
     assert rough["floor"][2] - exact["floor"][2] == pytest.approx(error.floor, abs=1e-6)
     # The copy still shows the pair's panorama: only the proxy changed, never the pixels.
     assert Path(rough["image"]).resolve() == pair["input"].resolve()
+
+
+@pytest.mark.slow
+def test_a_box_proxy_is_the_objects_bounding_box_in_its_own_frame(tmp_path) -> None:
+    # The stool (three legs, a round seat, turned 10 degrees) as a user models it at first: a box.
+    spec = S.get("stool")
+    pair = render_pair(spec)
+    written = perturbed_blend(pair["blend"], spec.remove, parse("box"), tmp_path / "box.blend")
+    exact, box = _read_back(spec.remove, pair["blend"], written.path)
+    assert exact["vertices"] > 8 and box["vertices"] == 8
+    np.testing.assert_allclose(box["local_lo"], exact["local_lo"], atol=1e-6)
+    np.testing.assert_allclose(box["local_hi"], exact["local_hi"], atol=1e-6)
+    np.testing.assert_allclose(box["matrix"], exact["matrix"], atol=1e-6)
+    # Turned with the object, the box stands out of the stool's own world bounds at its corners.
+    assert np.all(np.array(box["lo"][:2]) <= np.array(exact["lo"][:2]) + 1e-6)
+    assert box["lo"][2] == pytest.approx(exact["lo"][2], abs=1e-6)
 
 
 @pytest.mark.slow
