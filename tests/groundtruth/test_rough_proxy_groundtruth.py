@@ -55,6 +55,18 @@ ALIGNED_CASES = ["shift 5 cm at 45 deg", "turn 5 deg", "scale 0.95", "scale 1.05
 HARD = ("wall_contact", "shift 5 cm at 45 deg")
 ALIGNED_MARGIN = 0.05
 GHOST_MARGIN = 0.02
+# A box modelled for an open object (`parse("box")`: its bounding box in its own frame), held to
+# the same margin. The box casts a box's shadow and the ratio form relights all of it, floor the
+# photograph shows lit between the legs or beside the chair included (docs/limits.md): where it
+# fails, the test is marked xfail (strict) with what it measured. Each scene at a render the
+# suite makes anyway (the stool's default, the window-lit hotel_chair's 512x256).
+BOX_CASES = [
+    pytest.param("oak_chair", None, id="oak_chair"),
+    pytest.param("stool", None, id="stool",
+                 marks=pytest.mark.xfail(strict=True, reason="measured 0.362 against the exact proxy's 0.183")),
+    pytest.param("hotel_chair", {"width": 512, "height": 256, "samples": 32}, id="hotel_chair",
+                 marks=pytest.mark.xfail(strict=True, reason="measured 0.369 against the exact proxy's 0.184")),
+]
 
 
 # --- names and matrices (no Blender) ----------------------------------------------------------
@@ -199,6 +211,18 @@ def test_a_box_proxy_is_the_objects_bounding_box_in_its_own_frame(tmp_path) -> N
     # Turned with the object, the box stands out of the stool's own world bounds at its corners.
     assert np.all(np.array(box["lo"][:2]) <= np.array(exact["lo"][:2]) + 1e-6)
     assert box["lo"][2] == pytest.approx(exact["lo"][2], abs=1e-6)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("name", "render"), BOX_CASES)
+def test_a_box_for_an_open_object_stays_near_the_exact_proxy(name, render, tmp_path) -> None:
+    spec = S.get(name) if render is None else S.get(name).with_render(**render)
+    pair = render_pair(spec)
+    exact = run_case(pair, spec.remove, ProxyError(), tmp_path / "exact")
+    box = run_case(pair, spec.remove, parse("box"), tmp_path / "box")
+    assert exact.failure is None and box.failure is None, box.failure or exact.failure
+    assert box.nans == 0
+    assert box.total <= exact.total + TOTAL_MARGIN, f"box {box.total:.3f}, exact {exact.total:.3f}"
 
 
 @pytest.mark.slow
