@@ -35,8 +35,8 @@ def _moved(obj: bpy.types.Object, e: np.ndarray) -> None:
 
 def _bounding_box_mesh(obj: bpy.types.Object) -> bpy.types.Mesh:
     """A new mesh: the six faces, turned outwards, of `obj`'s bounding box in its own frame."""
-    lo = np.array([min(c) for c in zip(*obj.bound_box, strict=True)])
-    hi = np.array([max(c) for c in zip(*obj.bound_box, strict=True)])
+    box = np.array([tuple(corner) for corner in obj.bound_box])
+    lo, hi = box.min(axis=0), box.max(axis=0)
     corners = [(x, y, z) for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])]
     faces = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
     mesh = bpy.data.meshes.new(f"{obj.name}.box")

@@ -14,16 +14,16 @@ from collections.abc import Callable
 import numpy as np
 
 from addon.geometry import latlong
-from addon.geometry.mesh import build_geometry
 from addon.geometry.raycast import first_hits
 from addon.io.exr import read_exr
+from addon.light.radiosity import LUMA
+from addon.removal.target import scene_geometry
 from addon.scene import SceneData
 
 from .metrics import dilate
 from .photo_texture import baked_floor
 from .spec import SceneSpec
 
-_LUMA = np.array([0.2126, 0.7152, 0.0722])
 _AROUND = (2, 12)  # pixels from the object: the ring the floor around it is read in
 
 
@@ -34,7 +34,7 @@ def printed_level(spec: SceneSpec, scene: SceneData, mask: np.ndarray) -> float:
     room, photo = spec.room, spec.room.floor.photo
     if photo is None:
         return float("nan")
-    texture = read_exr(str(baked_floor(room, photo))) @ _LUMA
+    texture = read_exr(str(baked_floor(room, photo))) @ LUMA
     th, tw = texture.shape
 
     def albedo(x: np.ndarray, y: np.ndarray) -> np.ndarray:
@@ -54,17 +54,16 @@ def albedo_level(scene: SceneData, mask: np.ndarray, removed: str,
     painted at the level around it. NaN where neither side shows the floor."""
     h, w = mask.shape
     rows, cols = np.nonzero(dilate(mask, _AROUND[1]))
-    geo = build_geometry(scene.triangles, scene.tri_object, scene.object_names, scene.center, scene.rotation)
+    geo = scene_geometry(scene)
     floor, index = scene.object_names.index("Floor"), scene.object_names.index(removed)
     directions = latlong.pixel_directions_at(rows, cols, w, h)
-    origins = np.zeros_like(directions)
     kept = geo.tri_object != index
-    without, distance = first_hits(origins, directions, geo.triangles[kept])
-    seen, _ = first_hits(origins, directions, geo.triangles)
+    # One trace without the object serves both sides: the pixels around it do not see it.
+    hit, distance = first_hits(np.zeros_like(directions), directions, geo.triangles[kept])
+    on_floor = (hit >= 0) & (geo.tri_object[kept][np.maximum(hit, 0)] == floor)
     inside = mask[rows, cols]
-    hidden = inside & (without >= 0) & (geo.tri_object[kept][np.maximum(without, 0)] == floor)
-    around = ~inside & (seen >= 0) & (geo.tri_object[np.maximum(seen, 0)] == floor)
-    around &= ~dilate(mask, _AROUND[0])[rows, cols]
+    hidden = inside & on_floor
+    around = ~dilate(mask, _AROUND[0])[rows, cols] & on_floor
     if not hidden.any() or not around.any():
         return float("nan")
     world = (directions * distance[:, None]) @ np.asarray(scene.rotation, dtype=np.float64) + np.asarray(scene.center)
