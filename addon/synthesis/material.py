@@ -207,7 +207,8 @@ def _dark_clutter(log_y: np.ndarray, candidates: np.ndarray, band: np.ndarray) -
 def _shadow_halo(mean: np.ndarray, log_y: np.ndarray, known: np.ndarray, material: np.ndarray, hole: np.ndarray,
                  reach: int) -> np.ndarray:
     """(h, w) the `known` cells within `reach` of `hole` joined to it through cells of the
-    object's shadow left darker than the `material` cells (those beyond `reach`): `mean`
+    object's shadow left darker than the `material` cells (the caller's, beyond `reach` where it
+    sees any there): `mean`
     (`colour_features`) below `_HALO_DARKER` of their median and `_HALO_BELOW` of their
     `_HALO_QUANTILE`, in their chromaticity and smooth (`log_y`: log luminance). The fill is not
     to continue it."""
