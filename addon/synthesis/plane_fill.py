@@ -19,7 +19,7 @@ from ..light.radiosity import LUMA
 from ..segmentation.masks import box_mean
 from .crossing import fill_crossing, find_crossing
 from .lines import sharpened_across
-from .material import Material, border_material, wall_material
+from .material import Material, border_material, sharp_exemplar, wall_material
 from .plank_profile import PlankProfile, fold_profile
 from .structure import Filled, fill_structured
 from .texture import SynthesisParams
@@ -155,6 +155,9 @@ def fill_surface(
     # Only the hole's own material is copied; other things seen beside the hole (the object's
     # legs, a rug's edge) are repainted as context so that nothing continues them into it.
     exemplar, to_fill = material.exemplar, hole | material.replaced
+    footprint = _footprint(raster)
+    if not wall and crossing is None:  # a wall's columns and a band's regions are continued as they are
+        exemplar = sharp_exemplar(exemplar, footprint, to_fill)
     mean = values[exemplar].mean(axis=0) if exemplar.any() else np.zeros(3)
     image = np.where(exemplar[..., None], values, mean)
     filled = None
@@ -170,7 +173,7 @@ def fill_surface(
             else:
                 # the repainted cells are composed anew, but what they show still weighs the copies there
                 filled = fill_structured(image, exemplar, to_fill, options.synthesis, structure=options.structure,
-                                         footprint=_footprint(raster) if options.structure else None, guide=values,
+                                         footprint=footprint if options.structure else None, guide=values,
                                          guided=material.replaced, seed=options.seed, progress=on_level,
                                          cancel=cancel)
         except DimredError:

@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from addon.segmentation.masks import dilate
-from addon.synthesis.material import _shadow_halo, border_material, colour_features, log_luminance
+from addon.synthesis.material import _shadow_halo, border_material, colour_features, log_luminance, sharp_exemplar
 
 _H, _W = 120, 160
 
@@ -202,3 +202,34 @@ def test_a_fine_print_as_dark_beside_the_hole_is_no_shadow() -> None:
             assert not halo[print_].any()
         else:
             assert halo[(shade < 0.7) & dilate(hole, 8)].mean() > 0.9
+
+
+def _footprint() -> np.ndarray:
+    """How coarsely a panorama resolves each cell of a floor seen from above its left edge:
+    finest there, coarser with the distance."""
+    return np.broadcast_to(1.0 + (np.arange(_W) / 40) ** 2, (_H, _W))
+
+
+def test_cells_resolved_far_more_coarsely_than_the_hole_are_not_copied() -> None:
+    hole, known = _hole(), ~_hole()
+    footprint = _footprint()
+    limit = 2 * np.median(footprint[hole])
+    got = sharp_exemplar(known, footprint, hole)
+    assert got.any() and not (got & ~known).any()
+    assert (footprint[got] <= limit).all()
+    # all the cells within that resolution stay, those beside the hole among them
+    assert np.array_equal(got, known & (footprint <= limit))
+    assert got[hole.nonzero()[0].min(), hole.nonzero()[1].max() + 1]
+
+
+def test_where_few_cells_are_as_sharp_the_finest_twice_the_holes_are_kept() -> None:
+    hole = _hole()
+    known = np.zeros_like(hole)
+    known[:, 130:] = True  # seen only far beyond the hole, all of it coarser than twice the hole's
+    footprint = _footprint()
+    got = sharp_exemplar(known, footprint, hole)
+    assert got.sum() >= 2 * hole.sum() and got.sum() < known.sum()
+    assert footprint[got].max() <= footprint[known & ~got].min()
+    # a small exemplar is kept whole
+    few = known & (np.arange(_H) < 10)[:, None]
+    assert np.array_equal(sharp_exemplar(few, footprint, hole), few)
