@@ -76,23 +76,26 @@ def hidden_light(solution: Solution, revealed: Revealed, callbacks: RunCallbacks
 
 
 def fill_hidden(solution: Solution, revealed: Revealed, light: HiddenLight, rep: Report, callbacks: RunCallbacks,
-                show: Callable[[np.ndarray], None] | None = None) -> np.ndarray:
+                show: Callable[[np.ndarray], None] | None = None) -> tuple[np.ndarray, np.ndarray | None]:
     """(K, 3) radiance change of the revealed pixels: synthesised reflectance lit by the
-    irradiance after removal (`light`).
+    irradiance after removal (`light`); and `filled_reflectance`'s lift of the object's shadow.
 
     `show(change)` gets the revealed pixels' change as the fill refines: first with each
     patch's mean reflectance, then after every synthesis level of every surface and with each
     surface's final fill."""
     shown = None if show is None else (lambda rho: show(light.change(rho, revealed.radiance)))
-    return light.change(filled_reflectance(solution, revealed, rep, callbacks, show=shown), revealed.radiance)
+    rho, lift = filled_reflectance(solution, revealed, rep, callbacks, show=shown)
+    return light.change(rho, revealed.radiance), lift
 
 
 def filled_reflectance(solution: Solution, revealed: Revealed, rep: Report, callbacks: RunCallbacks, *,
-                       show: Callable[[np.ndarray], None] | None = None) -> np.ndarray:
+                       show: Callable[[np.ndarray], None] | None = None) -> tuple[np.ndarray, np.ndarray | None]:
     """(K, 3) the reflectance of the revealed pixels, synthesised surface by surface (each
-    patch's mean reflectance where a surface is too little seen). It needs no light, so a
-    full-resolution removal computes the light after the removal meanwhile. `show(rho)` gets
-    it as `fill_hidden`'s `show` says."""
+    patch's mean reflectance where a surface is too little seen); and over the pixels of
+    `revealed.panorama`, the factor (h, w) that lifts the object's shadow the relighting left
+    darker than its surface beside the hole (`shadow_lift`; None where there is none). It needs
+    no light, so a full-resolution removal computes the light after the removal meanwhile.
+    `show(rho)` gets it as `fill_hidden`'s `show` says."""
     geo = solution.geo
     patch, _, _ = solution.room.patches.lattice.locate(revealed.tri, revealed.bary)
     rho = solution.room.rho[patch].copy()
@@ -124,7 +127,7 @@ def filled_reflectance(solution: Solution, revealed: Revealed, rep: Report, call
     # large object) are filled side by side: each is numpy on arrays of its own, and they are
     # taken in order afterwards. The hotel photograph's three took 1.65 s, now 1.13 s.
     fills = each(fill, planes) if show is None else map(fill, planes)  # with a preview, each shown as it comes
-    surfaces = []
+    surfaces, lift = [], None
     for (sel, _), (got, seconds) in zip(planes, fills, strict=True):
         name = geo.object_names[geo.tri_object[revealed.tri[sel[0]]]]
         if got.known_cells:
@@ -145,13 +148,26 @@ def filled_reflectance(solution: Solution, revealed: Revealed, rep: Report, call
                          "synthesised": got.synthesised, "structured_cells": got.structured,
                          "band_cells": got.band_cells,
                          "exemplar": got.material.source, "exemplar_share": round(got.material.share, 3),
-                         "seconds": round(seconds, 4)})
+                         "shadow_lifted_pixels": got.lifted_pixels, "seconds": round(seconds, 4)})
+        if got.lift is not None:  # a surface filled in parts lifts its pixels once
+            lift = got.lift if lift is None else np.maximum(lift, got.lift)
     rep.info["filled_surfaces"] = surfaces
     if revealed.edges is not None and revealed.edges.edges:
         names = {int(k): geo.object_names[geo.tri_object[t]] for k, t in zip(*np.unique(solution.target.surface_key,
                                                                                        return_index=True), strict=True)}
         rep.info["surface_edges"] = [edge.describe(names) for edge in revealed.edges.edges]
-    return rho
+    return rho, lift
+
+
+def lifted(radiance: np.ndarray, change: np.ndarray, lift: np.ndarray | None) -> np.ndarray:
+    """`change` (h, w, 3) of `radiance` (h, w, 3) with the edited radiance multiplied by `lift`
+    (h, w; `filled_reflectance`) where it is above 1."""
+    if lift is None:
+        return change
+    out = np.array(change, copy=True)
+    at = lift > 1
+    out[at] = (np.maximum(radiance[at], 0.0) + change[at]) * lift[at, None] - np.maximum(radiance[at], 0.0)
+    return out
 
 
 def _material_warning(surface: str, material: Material) -> str:

@@ -32,6 +32,7 @@ from .fill import (
     filled_reflectance,
     hidden_light,
     hidden_planes,
+    lifted,
     measured_reflectance,
     moved_across,
     onto_photographed,
@@ -128,8 +129,9 @@ def full_resolution(solution: Solution, hdri: np.ndarray, rep: Report, callbacks
         with rep.stage("hidden_light"):
             found = _revealed(solution, window, window_e, radiance, surfaces, revealed)
 
-    def synthesis() -> np.ndarray | None:
-        """The revealed pixels' reflectance, None where there are none."""
+    def synthesis() -> tuple[np.ndarray, np.ndarray | None] | None:
+        """The revealed pixels' reflectance and the lift of the object's shadow beside them
+        (`filled_reflectance`), None where there are none."""
         if found is None:
             return None
         with rep.stage("synthesis"):
@@ -148,13 +150,15 @@ def full_resolution(solution: Solution, hdri: np.ndarray, rep: Report, callbacks
     # noise is matched and the light after the removal is found (the 8K box's 1.4 s of
     # synthesis beside 0.45 and 0.7 s): none of them reads what another writes, and the fill's
     # pixels are written over the matched noise after.
-    (quiet, after), rho = both(light, synthesis)
+    (quiet, after), filled = both(light, synthesis)
     difference[rows, cols] = quiet.change
     if found is None:
         rep.skip("synthesis", "nothing is behind the object to fill")
     else:
         with rep.stage("synthesis"):
+            rho, lift = filled
             difference[rows[revealed], cols[revealed]] = after.change(rho, found.radiance)
+            difference[rows, cols] = lifted(radiance, difference[rows, cols], lift)
             surface = found.panorama.maps.surface_without.copy()  # the surfaces as the fill took them
             surface[revealed] = solution.target.surface_key[found.tri]
             difference[rows, cols] = seamless_block_change(radiance, difference[rows, cols], revealed, surface)

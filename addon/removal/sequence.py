@@ -23,7 +23,7 @@ from ..scene import SceneData
 from ..segmentation.seen import SeenObject, seen_object
 from ..segmentation.user_mask import UserMask
 from .compose import compose
-from .fill import fill_hidden, filled_surfaces, hidden_light, working_measured, working_revealed
+from .fill import fill_hidden, filled_surfaces, hidden_light, lifted, working_measured, working_revealed
 from .first_order import first_order
 from .full_resolution import full_resolution
 from .lit_room import LitRoom
@@ -149,8 +149,9 @@ def finish(solution: Solution, rep: Report, callbacks: RunCallbacks = NO_CALLBAC
             light = hidden_light(solution, found, callbacks)
         with rep.stage("synthesis"):
             # the seam is the fill's last step: it stays within the stages a removal reports
-            difference = _seamless(solution, filled_surfaces(solution, found),
-                                   difference_image(fill_hidden(solution, found, light, rep, callbacks, show)))
+            change, lift = fill_hidden(solution, found, light, rep, callbacks, show)
+            difference = lifted(np.asarray(solution.hdri, np.float32), difference_image(change), lift)
+            difference = _seamless(solution, filled_surfaces(solution, found), difference)
     else:
         difference = difference_image(np.zeros((0, 3)))
         rep.skip("synthesis", "the object is not visible from the probe centre: no hidden region to fill"

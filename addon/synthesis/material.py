@@ -93,6 +93,10 @@ class Material:
     source: str
     share: float  # exemplar cells / known cells
     decided: bool = True  # False: too little is seen around the hole to tell its material
+    # of `replaced`, the object's shadow left darker than the material; and the cells past it that
+    # are its penumbra (`_shadow_halo`); None where the material is not told by its border
+    shadow: np.ndarray | None = None
+    penumbra: np.ndarray | None = None
 
     @property
     def mostly_other(self) -> bool:
@@ -166,13 +170,13 @@ def border_material(image: np.ndarray, known: np.ndarray, hole: np.ndarray, *, m
     nearby, _ = box_mean(exemplar[..., None].astype(np.float64), known, _SCATTER_RADIUS)
     exemplar &= nearby[..., 0] >= 0.5
     outer = exemplar & rings[1][0]
-    halo = _shadow_halo(mean, log_y, known, outer if outer.any() else exemplar & near, hole, reach // 2)
+    halo, penumbra = _shadow_halo(mean, log_y, known, outer if outer.any() else exemplar & near, hole, reach // 2)
     exemplar &= ~dilate(halo, 1)
     if exemplar.sum() < min_cells:
         return replace(undecided, decided=True)
     # Only what is wider than a line is repainted beside the hole: a thin stripe is only left out.
     return Material(exemplar=exemplar, replaced=(near & wide) | halo, source="border material",
-                    share=float(exemplar.sum() / known.sum()))
+                    share=float(exemplar.sum() / known.sum()), shadow=halo, penumbra=penumbra)
 
 
 def ring_widths(hole: np.ndarray) -> tuple[int, int]:
@@ -231,24 +235,28 @@ def _dark_clutter(log_y: np.ndarray, candidates: np.ndarray, band: np.ndarray) -
 
 
 def _shadow_halo(mean: np.ndarray, log_y: np.ndarray, known: np.ndarray, material: np.ndarray, hole: np.ndarray,
-                 reach: int) -> np.ndarray:
+                 reach: int) -> tuple[np.ndarray, np.ndarray]:
     """(h, w) the `known` cells within `reach` of `hole` joined to it through cells of the
     object's shadow left darker than the `material` cells (the caller's, beyond `reach` where it
     sees any there): `mean`
     (`colour_features`) below `_HALO_DARKER` of their median and `_HALO_BELOW` of their
     `_HALO_QUANTILE`, in their chromaticity and smooth (`log_y`: log luminance). The fill is not
-    to continue it."""
+    to continue it. And (h, w) its penumbra: the cells within `reach` past it, in that
+    chromaticity, smooth and below the median."""
     if not material.any():
-        return np.zeros_like(hole)
+        return np.zeros_like(hole), np.zeros_like(hole)
     levels = mean[..., 0][material]
     level = min(np.median(levels) + np.log(_HALO_DARKER), np.quantile(levels, _HALO_QUANTILE) + np.log(_HALO_BELOW))
     chroma = np.median(mean[..., 1:][material], axis=0)
     square, _ = box_mean((log_y**2)[..., None], known, 1)
     deviation = np.sqrt(np.maximum(square[..., 0] - mean[..., 0] ** 2, 0.0))
-    shade = (known & dilate(hole, reach) & (mean[..., 0] < level)
-             & (np.abs(mean[..., 1:] - chroma).max(axis=-1) < _STEPS[1]) & (deviation < _HALO_SMOOTH))
+    alike = known & (np.abs(mean[..., 1:] - chroma).max(axis=-1) < _STEPS[1]) & (deviation < _HALO_SMOOTH)
+    shade = alike & dilate(hole, reach) & (mean[..., 0] < level)
     labels, _ = components(shade | hole)
-    return shade & np.isin(labels, np.unique(labels[hole]))
+    halo = shade & np.isin(labels, np.unique(labels[hole]))
+    # its penumbra: the cells past it, as far again, in its colour, smooth and darker than the median
+    penumbra = alike & dilate(halo, reach) & ~halo & (mean[..., 0] < np.median(levels)) if halo.any() else halo
+    return halo, penumbra
 
 
 def _directions(flat: np.ndarray, shape: tuple[int, ...], ring: np.ndarray, centre: tuple[float, float]

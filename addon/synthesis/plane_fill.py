@@ -21,6 +21,7 @@ from .crossing import fill_crossing, find_crossing
 from .lines import sharpened_across
 from .material import Material, border_material, sharp_exemplar, wall_material
 from .plank_profile import PlankProfile, fold_profile
+from .shadow_lift import shadow_gain
 from .structure import Filled, fill_structured
 from .texture import SynthesisParams
 from .wall_columns import fill_wall
@@ -113,6 +114,13 @@ class SurfaceFill:
     material: Material  # which seen cells served as exemplar
     structured: int = 0  # hole cells composed from shifted copies (the rest: order-independent synthesis)
     band_cells: int = 0  # hole cells of a band continued across the hole (`crossing`)
+    # (h, w) over the panorama maps' pixels, the factor that lifts the object's shadow the
+    # relighting left darker than this surface beside the hole (`shadow_lift`); None: no such shadow
+    lift: np.ndarray | None = None
+
+    @property
+    def lifted_pixels(self) -> int:
+        return 0 if self.lift is None else int((self.lift > 1).sum())
 
 
 def fill_surface(
@@ -156,8 +164,16 @@ def fill_surface(
     # legs, a rug's edge) are repainted as context so that nothing continues them into it.
     exemplar, to_fill = material.exemplar, hole | material.replaced
     footprint = _footprint(raster)
+    lift = None
     if not wall and crossing is None:  # a wall's columns and a band's regions are continued as they are
         exemplar = sharp_exemplar(exemplar, footprint, to_fill)
+        gain = shadow_gain(values, known, material, hole)
+        if gain is not None:
+            # the fill meets, and copies from, the surface as the lifted photograph shows it
+            lift = _lift(panorama, plane, raster, gain)
+            values = values * gain[..., None]
+            if lift is not None:
+                panorama = replace(panorama, rho=panorama.rho * lift[..., None])
     mean = values[exemplar].mean(axis=0) if exemplar.any() else np.zeros(3)
     image = np.where(exemplar[..., None], values, mean)
     filled = None
@@ -186,7 +202,33 @@ def fill_surface(
     return SurfaceFill(rho=rho, raster_shape=raster.shape, cell=raster.cell, known_cells=int(known.sum()),
                        hole_cells=int(to_fill.sum()), synthesised=filled is not None,
                        structured=0 if structure is None else int(structure.covered.sum()), material=material,
-                       band_cells=crossing.band_cells if crossing is not None and filled is not None else 0)
+                       band_cells=crossing.band_cells if crossing is not None and filled is not None else 0,
+                       lift=lift)
+
+
+def _seen_points(panorama: PanoramaReflectance, rows: np.ndarray, cols: np.ndarray, raster: planeraster.PlaneRaster
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """(N, 3) the points the panorama maps' pixels (rows, cols) see (with the object), and (N,)
+    which of them lie within `raster`."""
+    maps = panorama.maps
+    frame = maps.frame or planeraster.Frame.whole(maps.surface_with.shape)
+    directions = latlong.pixel_directions_at(rows + frame.row0, np.mod(cols + frame.col0, frame.width), frame.width,
+                                             frame.height)
+    points = directions * maps.distance_with[rows, cols][:, None]
+    row, col = raster.coords(points)
+    h, w = raster.shape
+    return points, (row >= 0) & (row <= h - 1) & (col >= 0) & (col <= w - 1)
+
+
+def _lift(panorama: PanoramaReflectance, plane: HiddenPlane, raster: planeraster.PlaneRaster, gain: np.ndarray
+          ) -> np.ndarray | None:
+    """(h, w) over the panorama maps' pixels, the raster's `gain` (`shadow_lift.shadow_gain`) at
+    the pixels that show the plane's surface, 1 elsewhere; None where it lifts none of them."""
+    rows, cols = np.nonzero(panorama.shows(plane.surface))
+    points, inside = _seen_points(panorama, rows, cols, raster)
+    lift = np.ones(panorama.valid.shape, np.float32)
+    lift[rows[inside], cols[inside]] = planeraster.sample_raster(raster, gain[..., None], points[inside])[:, 0]
+    return lift if (lift > 1).any() else None
 
 
 def _sharpened_lines(filled: Filled) -> np.ndarray:
@@ -231,19 +273,11 @@ def _plank_profile(panorama: PanoramaReflectance, plane: HiddenPlane, raster: pl
     """The profile across the planks (which run along raster axis `along`) of the plane's pixels
     seen on the raster: each pixel's reflectance over the raster's mean around it (its own fine
     detail, free of the light and of the planks' shades), folded over the planks' width."""
-    maps = panorama.maps
-    seen = panorama.shows(plane.surface)
-    rows, cols = np.nonzero(seen)
+    rows, cols = np.nonzero(panorama.shows(plane.surface))
     if len(rows) > _PROFILE_PIXELS:
         pick = np.sort(np.random.default_rng(0).choice(len(rows), _PROFILE_PIXELS, replace=False))
         rows, cols = rows[pick], cols[pick]
-    frame = maps.frame or planeraster.Frame.whole(seen.shape)
-    directions = latlong.pixel_directions_at(rows + frame.row0, np.mod(cols + frame.col0, frame.width), frame.width,
-                                             frame.height)
-    points = directions * maps.distance_with[rows, cols][:, None]
-    row, col = raster.coords(points)
-    h, w = raster.shape
-    inside = (row >= 0) & (row <= h - 1) & (col >= 0) & (col <= w - 1)
+    points, inside = _seen_points(panorama, rows, cols, raster)
     mean, _ = box_mean((image @ LUMA)[..., None], known, _PROFILE_MEAN_RADIUS)
     local = planeraster.sample_raster(raster, mean, points[inside])[:, 0]
     value = panorama.rho[rows[inside], cols[inside]] @ LUMA

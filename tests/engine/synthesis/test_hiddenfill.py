@@ -152,3 +152,27 @@ def test_a_lane_between_two_floors_runs_on_under_the_lid_unless_structure_is_off
     off = fill_surface(panorama, floor, FillOptions(cell=0.01, margin=1.5, synthesis=SynthesisParams(),
                                                     structure=False))
     assert off.band_cells == 0
+
+
+def test_the_objects_shadow_left_beside_the_lid_is_lifted_to_the_floors_level():
+    """The relighting left a soft shadow darker than the floor along one side of the lid (a
+    proxy shallower than the object): the fill does not continue it, and the surface's pixels
+    there are lifted to the floor's level; nothing far from it is."""
+    panorama_maps, _, valid, floor, _ = setup()
+    points = latlong.pixel_directions(WIDTH, WIDTH // 2) * panorama_maps.distance_without[..., None]
+    grain = 1 + 0.03 * np.random.default_rng(5).standard_normal((WIDTH // 2, WIDTH, 1))
+    beyond = points[..., 1] - 1.2  # past the hidden square's far side
+    shade = np.where((beyond > 0) & (np.abs(points[..., 0] - 1.0) < 0.2), np.clip(0.45 + beyond / 0.3 * 0.55, 0, 1), 1)
+    rho = np.array([0.45, 0.30, 0.18]) * grain * shade[..., None]
+    got = fill_surface(PanoramaReflectance(rho, valid, panorama_maps), floor,
+                       FillOptions(cell=0.01, margin=1.5, synthesis=SynthesisParams()))
+    assert got.lift is not None and got.lifted_pixels > 0
+    level = 0.45 * 0.2126 + 0.30 * 0.7152 + 0.18 * 0.0722
+    dark = valid & (shade < 0.6)
+    assert dark.sum() > 30
+    lifted = (rho[dark] * got.lift[dark, None]) @ np.array([0.2126, 0.7152, 0.0722])
+    assert abs(np.median(lifted) / level - 1) < 0.1
+    far = valid & (np.hypot(points[..., 0] - 1.0, points[..., 1] - 1.0) > 0.8)
+    assert np.all(got.lift[far] == 1.0)
+    # the fill is the floor's level, not the shadow's
+    assert abs(np.median(got.rho @ np.array([0.2126, 0.7152, 0.0722])) / level - 1) < 0.1
