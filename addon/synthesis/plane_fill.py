@@ -166,7 +166,6 @@ def fill_surface(
     footprint = _footprint(raster)
     lift = None
     if not wall and crossing is None:  # a wall's columns and a band's regions are continued as they are
-        exemplar = sharp_exemplar(exemplar, footprint, to_fill)
         gain = shadow_gain(values, known, material, hole)
         if gain is not None:
             # the fill meets, and copies from, the surface as the lifted photograph shows it
@@ -187,11 +186,13 @@ def fill_surface(
                 filled = fill_wall(image, exemplar, to_fill, options.synthesis, seed=options.seed, progress=on_level,
                                    cancel=cancel)
             else:
-                # the repainted cells are composed anew, but what they show still weighs the copies there
+                # the repainted cells are composed anew, but what they show still weighs the copies there;
+                # the shifted copies are read from the photograph itself, only the per-pixel synthesis
+                # copies raster cells, which must be resolved about as finely as the hole's
                 filled = fill_structured(image, exemplar, to_fill, options.synthesis, structure=options.structure,
                                          footprint=footprint if options.structure else None, guide=values,
                                          guided=material.replaced, seed=options.seed, progress=on_level,
-                                         cancel=cancel)
+                                         cancel=cancel, sources=sharp_exemplar(exemplar, footprint, to_fill))
         except DimredError:
             pass  # too little exemplar: the mean below is the honest fallback, reported by the caller
     if filled is None:

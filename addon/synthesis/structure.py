@@ -116,11 +116,14 @@ class Filled:
 def fill_structured(image: np.ndarray, known: np.ndarray, hole: np.ndarray, params: SynthesisParams, *,
                     structure: bool = True, footprint: np.ndarray | None = None,
                     guide: np.ndarray | None = None, guided: np.ndarray | None = None, seed: int = 0,
-                    progress: ProgressFn | None = None, cancel: CancelFn | None = None) -> Filled:
+                    progress: ProgressFn | None = None, cancel: CancelFn | None = None,
+                    sources: np.ndarray | None = None) -> Filled:
     """`image` with its `hole` filled: composed from shifted copies where the texture repeats
     (with `structure`), the rest by the order-independent synthesis (`texture.fill_with_sources`,
     which raises `DimredError` on too little exemplar); and where each pixel was copied from.
-    `guide` at the `guided` hole pixels weighs the copies there (`structure_fill`).
+    `guide` at the `guided` hole pixels weighs the copies there (`structure_fill`). The
+    synthesis copies only the `sources` among the `known` pixels (default: all of them); all
+    of them constrain it.
     `progress(level, preview)` gets the composed image first (level -1) where the synthesis has
     more to do, then the synthesis's levels."""
     # Composed whatever the period of the repeats. Checkers of 17 cells (rotated_world at
@@ -137,10 +140,12 @@ def fill_structured(image: np.ndarray, known: np.ndarray, hole: np.ndarray, para
     if got is not None and progress is not None:
         progress(-1, got.image)
     start, constraint = (image, known) if got is None else (got.image, known | (hole & ~rest))
-    out, sources = fill_with_sources(start, constraint, rest, params, seed=seed, progress=progress, cancel=cancel)
+    copied = constraint if sources is None else constraint & (sources | ~known)
+    out, origin = fill_with_sources(start, constraint, rest, params, exemplar=start, exemplar_valid=copied, seed=seed,
+                                    progress=progress, cancel=cancel)
     # the composed pixels constrain the synthesis but are no photograph to read detail from
-    photographed = known[np.maximum(sources[..., 0], 0), np.maximum(sources[..., 1], 0)] & (sources[..., 0] >= 0)
-    return Filled(out, np.where(photographed[..., None], sources, -1), got)
+    photographed = known[np.maximum(origin[..., 0], 0), np.maximum(origin[..., 1], 0)] & (origin[..., 0] >= 0)
+    return Filled(out, np.where(photographed[..., None], origin, -1), got)
 
 
 def _plank_axis(image: np.ndarray, known: np.ndarray, hole: np.ndarray) -> int | None:

@@ -298,3 +298,18 @@ def test_guide_unlike_every_copy_prefers_none():
     free = shift_map(img, ~hole, hole, shifts[::-1])
     guided = shift_map(img, ~hole, hole, shifts[::-1], guide=dark, guided=repainted)
     np.testing.assert_array_equal(guided.labels, free.labels)
+
+
+def test_the_per_pixel_synthesis_copies_only_its_sources_while_every_known_pixel_constrains_it():
+    rng = np.random.default_rng(2)
+    image = (0.4 + 0.1 * rng.random((48, 64, 1))) * np.ones(3)
+    hole = np.zeros((48, 64), bool)
+    hole[18:30, 24:40] = True
+    known = ~hole
+    sources = known & (np.arange(64) < 32)[None, :]  # the left half only
+    got = fill_structured(image.astype(np.float32), known, hole, SynthesisParams(), structure=False, sources=sources)
+    origin = got.sources[hole]
+    assert (origin[:, 0] >= 0).all()
+    assert sources[origin[:, 0], origin[:, 1]].all()
+    everywhere = fill_structured(image.astype(np.float32), known, hole, SynthesisParams(), structure=False)
+    assert not sources[everywhere.sources[hole][:, 0], everywhere.sources[hole][:, 1]].all()
