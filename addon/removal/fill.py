@@ -166,7 +166,8 @@ def lifted(radiance: np.ndarray, change: np.ndarray, lift: np.ndarray | None) ->
         return change
     out = np.array(change, copy=True)
     at = lift > 1
-    out[at] = (np.maximum(radiance[at], 0.0) + change[at]) * lift[at, None] - np.maximum(radiance[at], 0.0)
+    photographed = np.maximum(radiance[at], 0.0)
+    out[at] = (photographed + change[at]) * lift[at, None] - photographed
     return out
 
 

@@ -163,7 +163,6 @@ def fill_surface(
     # Only the hole's own material is copied; other things seen beside the hole (the object's
     # legs, a rug's edge) are repainted as context so that nothing continues them into it.
     exemplar, to_fill = material.exemplar, hole | material.replaced
-    footprint = _footprint(raster)
     lift = None
     if not wall and crossing is None:  # a wall's columns and a band's regions are continued as they are
         gain = shadow_gain(values, known, material, hole)
@@ -189,6 +188,7 @@ def fill_surface(
                 # the repainted cells are composed anew, but what they show still weighs the copies there;
                 # the shifted copies are read from the photograph itself, only the per-pixel synthesis
                 # copies raster cells, which must be resolved about as finely as the hole's
+                footprint = _footprint(raster)
                 filled = fill_structured(image, exemplar, to_fill, options.synthesis, structure=options.structure,
                                          footprint=footprint if options.structure else None, guide=values,
                                          guided=material.replaced, seed=options.seed, progress=on_level,
