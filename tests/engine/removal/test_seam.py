@@ -59,3 +59,46 @@ def test_no_radiance_goes_negative() -> None:
     change[filled] -= 1.0
     got = seamless_change(radiance, change, filled, surface)
     assert (radiance + got >= -1e-6).all()
+
+
+def _planks(seed: int, *, contrast: float = 0.25) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A floor of planks 5 pixels wide whose shades differ by `contrast` (the steps between its
+    strips are larger than a few percent), its truth relit by +5 %, and a filled square."""
+    rng = np.random.default_rng(seed)
+    shade = 1 + contrast * rng.standard_normal(_W // 5 + 1).clip(-2, 2)
+    floor = 0.3 * np.repeat(shade, 5)[None, :_W, None] * np.array([1.0, 0.8, 0.5])
+    radiance = floor * (1 + 0.03 * rng.standard_normal((_H, _W, 1)))
+    filled = np.zeros((_H, _W), bool)
+    filled[20:60, 30:90] = True
+    return radiance, radiance * 1.05, filled
+
+
+def test_a_fill_off_by_the_same_amount_all_round_is_brought_to_the_photograph() -> None:
+    """On planks whose strips differ by about as much as the fill is off, one local step is no
+    evidence; the same step all around the fill is, and it is taken out, colour too (a fill
+    drawn from a paler stretch of a glossy floor). What stays is how well a border of some
+    planks tells their mean: a few percent either way."""
+    pale = np.array([1.15, 1.15, 1.25])  # brighter and bluer
+    surface = np.zeros((_H, _W), np.int64)
+    left = []
+    for seed in range(6):
+        radiance, truth, filled = _planks(seed, contrast=0.12)
+        edited = np.where(filled[..., None], truth * pale, truth)
+        got = radiance + seamless_change(radiance, (edited - radiance).astype(np.float32), filled, surface)
+        left.append(got[filled].mean(axis=0) / truth[filled].mean(axis=0) - 1)
+        # the fill's own planks are kept
+        assert np.corrcoef(got[30:50, 40:80, 1].ravel(), truth[30:50, 40:80, 1].ravel())[0, 1] > 0.95
+    left = np.abs(np.array(left)) / (pale - 1)
+    assert left.max() < 0.6 and left.mean() < 0.3
+
+
+def test_a_fill_whose_planks_differ_from_the_photographs_side_by_side_is_left_as_it_is() -> None:
+    """A fill of other planks than the truth's meets the photograph with steps of either sign:
+    no step is common to its whole border, and the planks' own steps are no seam."""
+    radiance, truth, filled = _planks(4)
+    other, _, _ = _planks(5)
+    edited = np.where(filled[..., None], other * 1.05, truth)
+    surface = np.zeros((_H, _W), np.int64)
+    change = (edited - radiance).astype(np.float32)
+    got = seamless_change(radiance, change, filled, surface)
+    assert np.abs(got - change)[filled].mean() < 0.03 * np.abs(edited[filled]).mean()
