@@ -11,7 +11,7 @@ import numpy as np
 from ..callbacks import RunCallbacks
 from ..geometry import latlong
 from ..geometry.mesh import Geometry, surfaces_of
-from ..geometry.planeraster import Frame, edge_direction, is_wall
+from ..geometry.planeraster import Frame, edge_direction
 from ..light.radiosity import RHO_MAX
 from ..report import Report
 from ..side_by_side import each
@@ -220,13 +220,6 @@ def filled_surfaces(solution: Solution, revealed: Revealed) -> np.ndarray:
 
 # Working pixels past the proxy's edge where a moved pixel takes its new surface's light: beside the corner.
 _ACROSS = 1.5
-
-
-def textured_surfaces(solution: Solution) -> np.ndarray:
-    """The surface keys whose planes are no walls (floors, ceilings, tables): their fill is a
-    texture synthesised from around the hole, a wall's continues its columns."""
-    keys, first = np.unique(solution.target.surface_key, return_index=True)
-    return keys[[not is_wall(n) for n in solution.geo.normals[first]]]
 
 
 def working_edges(solution: Solution) -> SurfaceEdges:

@@ -38,7 +38,6 @@ from .fill import (
     onto_photographed,
     surface_edges,
     surface_footprint,
-    textured_surfaces,
 )
 from .local import PointLight, Receiving, light_at
 from .object_window import ObjectWindow, object_window
@@ -162,8 +161,7 @@ def full_resolution(solution: Solution, hdri: np.ndarray, rep: Report, callbacks
             difference[rows, cols] = lifted(radiance, difference[rows, cols], lift)
             surface = found.panorama.maps.surface_without.copy()  # the surfaces as the fill took them
             surface[revealed] = solution.target.surface_key[found.tri]
-            difference[rows, cols] = seamless_block_change(radiance, difference[rows, cols], revealed, surface,
-                                                           textured=textured_surfaces(solution))
+            difference[rows, cols] = seamless_block_change(radiance, difference[rows, cols], revealed, surface)
     unseen = int(window.hidden.sum() - revealed.sum())
     if unseen:
         rep.warn(f"{unseen} pixels of the object see no proxy geometry behind it; they are left unchanged")

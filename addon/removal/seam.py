@@ -34,17 +34,13 @@ _ALIKE = 4.0  # within this factor of the boundary's median luminance: the surfa
 # steps' averaging along the boundary and the surface's own steps around it all lie within.
 _BLOCK_REACHES = 4
 _AROUND = 2  # reaches: the surface around the hole whose own steps are measured
-_ONE_SIGN = 0.8  # share of the boundary whose steps must have the sign of their median
 
 
-def seamless_change(radiance: np.ndarray, change: np.ndarray, filled: np.ndarray, surface: np.ndarray, *,
-                    textured: np.ndarray | None = None) -> np.ndarray:
+def seamless_change(radiance: np.ndarray, change: np.ndarray, filled: np.ndarray, surface: np.ndarray
+                    ) -> np.ndarray:
     """(h, w, 3) `change` with the `filled` pixels' (h, w) step against the rest taken out, per
     `surface` (h, w, the surface id each pixel shows once the object is gone; -1: none), for a
-    photograph `radiance` (h, w, 3). Nothing changes outside `filled`; no radiance goes below 0.
-    On the surfaces whose ids are `textured` (default: all), a step of one sign all around the
-    fill is taken out too; not on a wall, whose fill continues what stands on it column by column
-    (a dark curtain beside a bright one is no offset of the fill)."""
+    photograph `radiance` (h, w, 3). Nothing changes outside `filled`; no radiance goes below 0."""
     out = np.array(change, dtype=np.float32, copy=True)
     edited = np.maximum(radiance, 0.0) + out
     luma = edited @ LUMA
@@ -73,25 +69,19 @@ def seamless_change(radiance: np.ndarray, change: np.ndarray, filled: np.ndarray
         # A step of one sign all around the boundary is no texture's chance: tested against the
         # spread of a mean over as many strips as long as the surface's own steps' the boundary
         # holds (on 40 fills of other planks than the truth's, shades 25 % apart, the median step
-        # was 0.36 of the spread apart from 0, with 5 strips along the boundary). Its colour comes
-        # with it (a fill drawn from a paler stretch of a glossy floor).
+        # was 0.36 of the spread apart from 0, with 5 strips along the boundary).
         offset = np.median(step[boundary], axis=0)
         stretches = max(boundary.sum() / (2 * reach + 1), 1.0)
-        around = (_kept(offset @ LUMA, spread / np.sqrt(stretches))
-                  if (textured is None or s in textured) and _one_sign(step[boundary] @ LUMA) else 0.0)
+        # per channel, each against the surface's spread in its own scale: a fill drawn from a
+        # paler stretch of a glossy floor differs in colour more than in luminance
+        level = np.median(edited[outer], axis=0)
+        around = _kept(offset * typical / np.maximum(level, 1e-30), spread / np.sqrt(stretches))
         rest = step - offset * around
         kept = _kept(rest @ LUMA, spread)
         membrane = _pull_push(np.where(boundary[..., None], offset * around + rest * kept[..., None], 0.0), boundary)
         out[inside] += membrane[inside].astype(np.float32)
     np.maximum(out, -np.maximum(radiance, 0.0), out=out)
     return out
-
-
-def _one_sign(steps: np.ndarray) -> bool:
-    """Whether the luminance `steps` along a boundary are of one sign (`_ONE_SIGN` of them): a
-    fill continuing a wall's dark curtain beside a bright one meets the one above it and the
-    other beside it with steps of both signs, whose median is no offset of the fill."""
-    return max((steps > 0).mean(), (steps < 0).mean()) >= _ONE_SIGN
 
 
 def _kept(step: np.ndarray | float, spread: float) -> np.ndarray:
@@ -146,8 +136,8 @@ def _pull_push(values: np.ndarray, known: np.ndarray) -> np.ndarray:
     return np.where(known[..., None], values, smooth)
 
 
-def seamless_block_change(radiance: np.ndarray, change: np.ndarray, filled: np.ndarray, surface: np.ndarray, *,
-                          textured: np.ndarray | None = None) -> np.ndarray:
+def seamless_block_change(radiance: np.ndarray, change: np.ndarray, filled: np.ndarray, surface: np.ndarray
+                          ) -> np.ndarray:
     """`seamless_change` over an image that does not wrap around (a window of the panorama), on
     the block around the filled pixels that the step and the surface's own steps are measured
     in: at full resolution the object's window is several times larger than that."""
@@ -158,12 +148,12 @@ def seamless_block_change(radiance: np.ndarray, change: np.ndarray, filled: np.n
     rows, cols = np.flatnonzero(filled.any(axis=1)), np.flatnonzero(filled.any(axis=0))
     block = (slice(max(rows[0] - margin, 0), rows[-1] + margin + 1),
              slice(max(cols[0] - margin, 0), cols[-1] + margin + 1))
-    out[block] = seamless_change(radiance[block], out[block], filled[block], surface[block], textured=textured)
+    out[block] = seamless_change(radiance[block], out[block], filled[block], surface[block])
     return out
 
 
-def seamless_panorama_change(radiance: np.ndarray, change: np.ndarray, filled: np.ndarray, surface: np.ndarray, *,
-                             textured: np.ndarray | None = None) -> np.ndarray:
+def seamless_panorama_change(radiance: np.ndarray, change: np.ndarray, filled: np.ndarray, surface: np.ndarray
+                             ) -> np.ndarray:
     """`seamless_block_change` over a whole lat-long panorama, turned by whole columns so that
     the block lies away from the u seam, where the image's columns wrap around."""
     out = np.array(change, dtype=np.float32, copy=True)
@@ -175,6 +165,5 @@ def seamless_panorama_change(radiance: np.ndarray, change: np.ndarray, filled: n
     gaps = np.diff(np.concatenate([columns, [columns[0] + width]]))
     widest = int(np.argmax(gaps))
     turned = np.mod(int(columns[widest]) + int(gaps[widest]) // 2 + np.arange(width), width)
-    out[:, turned] = seamless_block_change(radiance[:, turned], out[:, turned], filled[:, turned], surface[:, turned],
-                                           textured=textured)
+    out[:, turned] = seamless_block_change(radiance[:, turned], out[:, turned], filled[:, turned], surface[:, turned])
     return out

@@ -23,15 +23,7 @@ from ..scene import SceneData
 from ..segmentation.seen import SeenObject, seen_object
 from ..segmentation.user_mask import UserMask
 from .compose import compose
-from .fill import (
-    fill_hidden,
-    filled_surfaces,
-    hidden_light,
-    lifted,
-    textured_surfaces,
-    working_measured,
-    working_revealed,
-)
+from .fill import fill_hidden, filled_surfaces, hidden_light, lifted, working_measured, working_revealed
 from .first_order import first_order
 from .full_resolution import full_resolution
 from .lit_room import LitRoom
@@ -232,8 +224,7 @@ def _seamless(solution: Solution, surface: np.ndarray, difference: np.ndarray) -
     shape = (traced.height, traced.width)
     filled = np.zeros(traced.height * traced.width, dtype=bool)
     filled[traced.hp[traced.behind.revealed]] = True
-    return seamless_panorama_change(np.asarray(solution.hdri, np.float32), difference, filled.reshape(shape), surface,
-                                    textured=textured_surfaces(solution))
+    return seamless_panorama_change(np.asarray(solution.hdri, np.float32), difference, filled.reshape(shape), surface)
 
 
 def _hit_image(traced: Traced, rows: np.ndarray) -> np.ndarray:

@@ -277,13 +277,3 @@ def test_the_shadow_lift_multiplies_the_edited_radiance_where_it_is_above_one():
     unlifted[0, 1] = False
     np.testing.assert_array_equal(got[unlifted], change[unlifted])
     assert fill.lifted(radiance, change, None) is change
-
-
-def test_the_floor_and_ceiling_are_textured_surfaces_the_walls_not(stages):
-    """The seam takes a step of one sign all round out of a texture's fill, not out of a wall's."""
-    solution, geo = stages["solution"], stages["geo"]
-    keys = solution.target.surface_key
-    textured = set(fill.textured_surfaces(solution).tolist())
-    vertical = np.abs(geo.normals[:, 2]) < 0.5
-    assert textured and textured == set(keys[~vertical].tolist())
-    assert not textured & set(keys[vertical].tolist())
