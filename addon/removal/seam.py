@@ -66,28 +66,11 @@ def seamless_change(radiance: np.ndarray, change: np.ndarray, filled: np.ndarray
         alike = (luma > typical / _ALIKE) & (luma < typical * _ALIKE)
         spread = _step_spread(luma, outside & alike & dilate(inside, _AROUND * reach), reach, band)
         step, _ = box_mean(np.where(boundary[..., None], m_out - m_in, 0.0), boundary, _ALONG * reach)
-        # A step of one sign all around the boundary is no texture's chance: tested against the
-        # spread of a mean over as many strips as long as the surface's own steps' the boundary
-        # holds (on 40 fills of other planks than the truth's, shades 25 % apart, the median step
-        # was 0.36 of the spread apart from 0, with 5 strips along the boundary).
-        offset = np.median(step[boundary], axis=0)
-        stretches = max(boundary.sum() / (2 * reach + 1), 1.0)
-        # per channel, each against the surface's spread in its own scale: a fill drawn from a
-        # paler stretch of a glossy floor differs in colour more than in luminance
-        level = np.median(edited[outer], axis=0)
-        around = _kept(offset * typical / np.maximum(level, 1e-30), spread / np.sqrt(stretches))
-        rest = step - offset * around
-        kept = _kept(rest @ LUMA, spread)
-        membrane = _pull_push(np.where(boundary[..., None], offset * around + rest * kept[..., None], 0.0), boundary)
+        kept = np.clip(1 - (_SIGNIFICANCE * spread / np.maximum(np.abs(step @ LUMA), 1e-30)) ** 2, 0.0, 1.0)
+        membrane = _pull_push(np.where(boundary[..., None], step * kept[..., None], 0.0), boundary)
         out[inside] += membrane[inside].astype(np.float32)
     np.maximum(out, -np.maximum(radiance, 0.0), out=out)
     return out
-
-
-def _kept(step: np.ndarray | float, spread: float) -> np.ndarray:
-    """The share of a luminance `step` taken out: none within `_SIGNIFICANCE` times `spread`
-    (the steps the surface shows by itself), nearly all of one far beyond it."""
-    return np.clip(1 - (_SIGNIFICANCE * spread / np.maximum(np.abs(step), 1e-30)) ** 2, 0.0, 1.0)
 
 
 def _step_spread(luma: np.ndarray, around: np.ndarray, reach: int, band: int) -> float:
