@@ -96,10 +96,12 @@ class Material:
     source: str
     share: float  # exemplar cells / known cells
     decided: bool = True  # False: too little is seen around the hole to tell its material
-    # of `replaced`, the object's shadow left darker than the material; and the cells past it that
-    # are its penumbra (`_shadow_halo`); None where the material is not told by its border
+    # of `replaced`, the object's shadow left darker than the material; the cells past it that
+    # are its penumbra (`_shadow_halo`); and the material's cells around the hole it was judged
+    # against; None where the material is not told by its border
     shadow: np.ndarray | None = None
     penumbra: np.ndarray | None = None
+    around: np.ndarray | None = None
 
     @property
     def mostly_other(self) -> bool:
@@ -172,14 +174,17 @@ def border_material(image: np.ndarray, known: np.ndarray, hole: np.ndarray, *, m
     # and not scattered in something else (a rug's stripes whose blends pass for wood)
     nearby, _ = box_mean(exemplar[..., None].astype(np.float64), known, _SCATTER_RADIUS)
     exemplar &= nearby[..., 0] >= 0.5
-    outer = exemplar & rings[1][0]
-    halo, penumbra = _shadow_halo(mean, log_y, known, outer if outer.any() else exemplar & near, hole, reach // 2)
+    # the material around the hole the object's shadow is judged against: beyond half the ring
+    # where it is seen there
+    around = exemplar & rings[1][0]
+    around = around if around.any() else exemplar & near
+    halo, penumbra = _shadow_halo(mean, log_y, known, around, hole, reach // 2)
     exemplar &= ~dilate(halo, 1)
     if exemplar.sum() < min_cells:
         return replace(undecided, decided=True)
     # Only what is wider than a line is repainted beside the hole: a thin stripe is only left out.
     return Material(exemplar=exemplar, replaced=(near & wide) | halo, source="border material",
-                    share=float(exemplar.sum() / known.sum()), shadow=halo, penumbra=penumbra)
+                    share=float(exemplar.sum() / known.sum()), shadow=halo, penumbra=penumbra, around=around)
 
 
 def ring_widths(hole: np.ndarray) -> tuple[int, int]:

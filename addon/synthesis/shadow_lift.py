@@ -35,18 +35,17 @@ def shadow_gain(values: np.ndarray, known: np.ndarray, material: Material, hole:
     shadow = material.shadow
     if shadow is None or shadow.sum() < _MIN_SHADOW * (hole & dilate(~hole, 1)).sum():
         return None
-    y = values @ LUMA
-    reach, _ = ring_widths(hole)
-    # the material's level around the hole, beyond the shadow's reach where it is seen there
-    around = material.exemplar & dilate(hole, reach) & ~dilate(hole, reach // 2)
-    around = around if around.any() else material.exemplar & dilate(hole, reach)
+    # the material's level around the hole, where the shadow was judged against it (the cells
+    # the shadow's margin took out of the exemplar are not the material's level)
+    around = material.around & material.exemplar
     if not around.any():
         return None
+    y = values @ LUMA
     level = float(np.median(y[around]))
     local, _ = box_mean(y[..., None], known, _LEVEL_RADIUS)
     deficit = np.clip(level / np.maximum(local[..., 0], 1e-9), 1.0, _MAX_LIFT)
     # 1 on the shadow, falling linearly to 0 over its penumbra
-    fade = max(reach // 2, 1)
+    fade = max(ring_widths(hole)[0] // 2, 1)
     weight = shadow.astype(np.float64)
     for step in range(1, fade + 1):
         weight = np.maximum(weight, (1 - step / (fade + 1)) * (dilate(shadow, step) & material.penumbra))
