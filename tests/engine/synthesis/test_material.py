@@ -204,6 +204,28 @@ def test_a_fine_print_as_dark_beside_the_hole_is_no_shadow() -> None:
             assert halo[(shade < 0.7) & dilate(hole, 8)].mean() > 0.9
 
 
+def test_a_shadow_in_the_floors_own_bounced_colour_is_shadow_another_hue_is_not() -> None:
+    """The light left in a shadow on a warm floor is the floor's own, bounced: the shadow is more
+    saturated than the floor (towards its colour squared), more than a colour step away, and is
+    still taken for the object's shadow. The same darkness turned towards blue is something else."""
+    hole = _hole()
+    floor = np.array([0.45, 0.30, 0.18]) * (1 + 0.03 * np.random.default_rng(13).standard_normal((_H, _W, 1)))
+    shade = _shade(0.4)
+    bounced = floor[0, 0] / (floor[0, 0] @ np.array([0.2126, 0.7152, 0.0722]))
+    depth = ((1 - shade) / 0.6)[..., None]  # 1 at the hole, 0 where the shadow ends
+    for tint, is_shadow in ((bounced, True), (np.array([0.6, 1.0, 2.2]), False)):
+        light = shade[..., None] * ((1 - depth) + depth * tint)
+        image = floor * light
+        log_y = log_luminance(image)
+        mean = colour_features(image, log_y, ~hole, radius=1)
+        deep = (shade < 0.7) & dilate(hole, 8) & ~hole
+        ring = ~hole & (shade == 1) & dilate(hole, 16)
+        offset = np.abs(np.median(mean[..., 1:][deep], axis=0) - np.median(mean[..., 1:][ring], axis=0)).max()
+        assert offset > 0.03  # more than a colour step from the floor
+        halo, _ = _shadow_halo(mean, log_y, ~hole, ring, hole, 8)
+        assert (halo[deep].mean() > 0.9) if is_shadow else not halo[deep].any()
+
+
 def _footprint() -> np.ndarray:
     """How coarsely a panorama resolves each cell of a floor seen from above its left edge:
     finest there, coarser with the distance."""
