@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from addon.segmentation.masks import dilate
+from addon.segmentation.masks import dilate, erode
 from addon.synthesis.material import _shadow_halo, border_material, colour_features, log_luminance, sharp_exemplar
 
 _H, _W = 120, 160
@@ -224,6 +224,29 @@ def test_a_shadow_in_the_floors_own_bounced_colour_is_shadow_another_hue_is_not(
         assert offset > 0.03  # more than a colour step from the floor
         halo, _ = _shadow_halo(mean, log_y, ~hole, ring, hole, 8)
         assert (halo[deep].mean() > 0.9) if is_shadow else not halo[deep].any()
+
+
+def test_a_floor_darkened_in_its_bounced_colour_past_the_shadow_is_no_penumbra() -> None:
+    """Past the object's shadow, a stretch of floor darker than its median in the floor's bounced
+    colour (darkened by its own light: a wall beside it) is no penumbra of the object's shadow,
+    and is not lifted; the shadow's own fade, in the floor's colour, is."""
+    hole = _hole()
+    floor = np.array([0.45, 0.30, 0.18]) * (1 + 0.03 * np.random.default_rng(14).standard_normal((_H, _W, 1)))
+    bounced = floor[0, 0] / (floor[0, 0] @ np.array([0.2126, 0.7152, 0.0722]))
+    shade = _shade(0.4)
+    light = shade[..., None] * np.where((shade < 0.7)[..., None], bounced, 1.0)
+    cols = np.arange(_W)[None, :]
+    wall = (shade == 1) & (cols >= 94) & (cols < 104) & (np.arange(_H)[:, None] >= 74)
+    light = np.where(wall[..., None], 0.85 * (0.5 + 0.5 * bounced), light)
+    image = floor * light
+    log_y = log_luminance(image)
+    mean = colour_features(image, log_y, ~hole, radius=1)
+    ring = ~hole & (shade == 1) & ~wall & dilate(hole, 16)
+    halo, penumbra = _shadow_halo(mean, log_y, ~hole, ring, hole, 8)
+    assert halo[(shade < 0.6) & dilate(hole, 4) & ~hole].mean() > 0.8
+    core = erode(wall, 1)
+    assert np.median(mean[..., 0][core]) < np.median(mean[..., 0][ring])  # darker than the median
+    assert not (penumbra | halo)[core].any()
 
 
 def _footprint() -> np.ndarray:
