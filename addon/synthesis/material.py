@@ -55,10 +55,10 @@ _MIN_SHARE_WARN = 0.5  # below this share of the seen cells, the surface is most
 # The object's shadow right beside the hole where the relighting leaves it darker than its surface
 # (a box proxy's shadow is not the armchair's): cells joined to the hole, within half the ring,
 # through cells darker than `_HALO_DARKER` of the material's median beyond that reach and than
-# `_HALO_BELOW` of its `_HALO_QUANTILE` there, in the colours its shadow takes (`_shadow_colours`)
-# and smooth (3x3 deviation of log luminance below `_HALO_SMOOTH`). Continued inward, it made the
-# bottom of the real hotel armchair's fill a dark patch (245 cells there, at 0.8-1 times the
-# quantile alike). The last three tell it from the material or paint: a checker's dark tiles are as dark
+# `_HALO_BELOW` of its `_HALO_QUANTILE` there, in its chromaticity (within one step) and smooth
+# (3x3 deviation of log luminance below `_HALO_SMOOTH`). Continued inward, it made the bottom of
+# the real hotel armchair's fill a dark patch (245 cells there, at 0.8-1 times the quantile
+# alike). The last three tell it from the material or paint: a checker's dark tiles are as dark
 # as the material's darkest beyond, and the exact proxy's shadow on them is relit to within a
 # few percent (at the quantile itself tile_stool's were taken for shadow, 153 cells, and its fill
 # without structure rose from 0.171 to 0.203 total error; basic_box's mean error from 0.000 to
@@ -248,46 +248,23 @@ def _shadow_halo(mean: np.ndarray, log_y: np.ndarray, known: np.ndarray, materia
     object's shadow left darker than the `material` cells (the caller's, beyond `reach` where it
     sees any there): `mean`
     (`colour_features`) below `_HALO_DARKER` of their median and `_HALO_BELOW` of their
-    `_HALO_QUANTILE`, in the colours their shadow takes and smooth (`log_y`: log luminance). The
-    fill is not to continue it. And (h, w) its penumbra: the cells within `reach` past it, in
-    the material's own chromaticity, smooth and below the median."""
+    `_HALO_QUANTILE`, in their chromaticity and smooth (`log_y`: log luminance). The fill is not
+    to continue it. And (h, w) its penumbra: the cells within `reach` past it, in that
+    chromaticity, smooth and below the median."""
     if not material.any():
         return np.zeros_like(hole), np.zeros_like(hole)
     levels = mean[..., 0][material]
     level = min(np.median(levels) + np.log(_HALO_DARKER), np.quantile(levels, _HALO_QUANTILE) + np.log(_HALO_BELOW))
-    square, _ = box_mean((log_y**2)[..., None], known, 1)
-    smooth = known & (np.sqrt(np.maximum(square[..., 0] - mean[..., 0] ** 2, 0.0)) < _HALO_SMOOTH)
     chroma = np.median(mean[..., 1:][material], axis=0)
-    shade = smooth & _shadow_colours(mean[..., 1:], chroma) & dilate(hole, reach) & (mean[..., 0] < level)
+    square, _ = box_mean((log_y**2)[..., None], known, 1)
+    deviation = np.sqrt(np.maximum(square[..., 0] - mean[..., 0] ** 2, 0.0))
+    alike = known & (np.abs(mean[..., 1:] - chroma).max(axis=-1) < _STEPS[1]) & (deviation < _HALO_SMOOTH)
+    shade = alike & dilate(hole, reach) & (mean[..., 0] < level)
     labels, _ = components(shade | hole)
     halo = shade & np.isin(labels, np.unique(labels[hole]))
-    # its penumbra: the cells past it, as far again, smooth and darker than the median, in the
-    # surface's own colour: lit mostly directly, and a floor darkened by its own light (by a wall
-    # beside it) in its bounced colour is no shadow of the object
-    own = np.abs(mean[..., 1:] - chroma).max(axis=-1) < _STEPS[1]
-    penumbra = smooth & own & dilate(halo, reach) & ~halo & (mean[..., 0] < np.median(levels)) if halo.any() else halo
+    # its penumbra: the cells past it, as far again, in its colour, smooth and darker than the median
+    penumbra = alike & dilate(halo, reach) & ~halo & (mean[..., 0] < np.median(levels)) if halo.any() else halo
     return halo, penumbra
-
-
-def _shadow_colours(chroma: np.ndarray, material: np.ndarray) -> np.ndarray:
-    """(h, w) bool: whether each chromaticity (r, g) of `chroma` (h, w, 2) is one a shadow on a
-    surface of chromaticity `material` (2,) takes, within one step.
-
-    The light left in a shadow is mostly what the surface around it and the object reflect into
-    it, so it comes in the surface's own colour after one more bounce (its rgb squared) as well
-    as in the light's: the shadow's chromaticity lies between the surface's and that of the
-    surface's colour times itself. On a warm wood floor it is more saturated than the floor: the
-    real lobby bench's, relit by its box proxy, has r 0.53-0.55 against the floor's 0.48-0.50,
-    and within one step of the floor's alone 8 of its cells passed for shadow (1.5 % of the
-    hole's border, too few to lift) where 1247 do now. Only the shadow itself is told so: taken
-    for its penumbra too, the floor darkened by the wall beyond apartment_chair's chair was
-    lifted (far damage 0.013 -> 0.064 at 256 wide, 0.041 with the penumbra in the floor's own
-    colour). On the photo-textured truths (512 wide, 4 seeds at 64 and 128 samples) it changed
-    only apartment_chair's fill, mean error 0.039 to 0.034, and hotel_rug_box's by 0.001."""
-    rgb = np.append(material, 1.0 - material.sum())
-    bounced = (rgb**2 / max(float((rgb**2).sum()), 1e-12))[:2] - material
-    t = np.clip(((chroma - material) @ bounced) / max(float(bounced @ bounced), 1e-12), 0.0, 1.0)
-    return np.abs(chroma - material - t[..., None] * bounced).max(axis=-1) < _STEPS[1]
 
 
 def _directions(flat: np.ndarray, shape: tuple[int, ...], ring: np.ndarray, centre: tuple[float, float]

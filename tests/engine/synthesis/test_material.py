@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from addon.segmentation.masks import dilate, erode
+from addon.segmentation.masks import dilate
 from addon.synthesis.material import _shadow_halo, border_material, colour_features, log_luminance, sharp_exemplar
 
 _H, _W = 120, 160
@@ -202,51 +202,6 @@ def test_a_fine_print_as_dark_beside_the_hole_is_no_shadow() -> None:
             assert not halo[print_].any()
         else:
             assert halo[(shade < 0.7) & dilate(hole, 8)].mean() > 0.9
-
-
-def test_a_shadow_in_the_floors_own_bounced_colour_is_shadow_another_hue_is_not() -> None:
-    """The light left in a shadow on a warm floor is the floor's own, bounced: the shadow is more
-    saturated than the floor (towards its colour squared), more than a colour step away, and is
-    still taken for the object's shadow. The same darkness turned towards blue is something else."""
-    hole = _hole()
-    floor = np.array([0.45, 0.30, 0.18]) * (1 + 0.03 * np.random.default_rng(13).standard_normal((_H, _W, 1)))
-    shade = _shade(0.4)
-    bounced = floor[0, 0] / (floor[0, 0] @ np.array([0.2126, 0.7152, 0.0722]))
-    depth = ((1 - shade) / 0.6)[..., None]  # 1 at the hole, 0 where the shadow ends
-    for tint, is_shadow in ((bounced, True), (np.array([0.6, 1.0, 2.2]), False)):
-        light = shade[..., None] * ((1 - depth) + depth * tint)
-        image = floor * light
-        log_y = log_luminance(image)
-        mean = colour_features(image, log_y, ~hole, radius=1)
-        deep = (shade < 0.7) & dilate(hole, 8) & ~hole
-        ring = ~hole & (shade == 1) & dilate(hole, 16)
-        offset = np.abs(np.median(mean[..., 1:][deep], axis=0) - np.median(mean[..., 1:][ring], axis=0)).max()
-        assert offset > 0.03  # more than a colour step from the floor
-        halo, _ = _shadow_halo(mean, log_y, ~hole, ring, hole, 8)
-        assert (halo[deep].mean() > 0.9) if is_shadow else not halo[deep].any()
-
-
-def test_a_floor_darkened_in_its_bounced_colour_past_the_shadow_is_no_penumbra() -> None:
-    """Past the object's shadow, a stretch of floor darker than its median in the floor's bounced
-    colour (darkened by its own light: a wall beside it) is no penumbra of the object's shadow,
-    and is not lifted; the shadow's own fade, in the floor's colour, is."""
-    hole = _hole()
-    floor = np.array([0.45, 0.30, 0.18]) * (1 + 0.03 * np.random.default_rng(14).standard_normal((_H, _W, 1)))
-    bounced = floor[0, 0] / (floor[0, 0] @ np.array([0.2126, 0.7152, 0.0722]))
-    shade = _shade(0.4)
-    light = shade[..., None] * np.where((shade < 0.7)[..., None], bounced, 1.0)
-    cols = np.arange(_W)[None, :]
-    wall = (shade == 1) & (cols >= 94) & (cols < 104) & (np.arange(_H)[:, None] >= 74)
-    light = np.where(wall[..., None], 0.85 * (0.5 + 0.5 * bounced), light)
-    image = floor * light
-    log_y = log_luminance(image)
-    mean = colour_features(image, log_y, ~hole, radius=1)
-    ring = ~hole & (shade == 1) & ~wall & dilate(hole, 16)
-    halo, penumbra = _shadow_halo(mean, log_y, ~hole, ring, hole, 8)
-    assert halo[(shade < 0.6) & dilate(hole, 4) & ~hole].mean() > 0.8
-    core = erode(wall, 1)
-    assert np.median(mean[..., 0][core]) < np.median(mean[..., 0][ring])  # darker than the median
-    assert not (penumbra | halo)[core].any()
 
 
 def _footprint() -> np.ndarray:
