@@ -158,10 +158,10 @@ def full_resolution(solution: Solution, hdri: np.ndarray, rep: Report, callbacks
         with rep.stage("synthesis"):
             rho, lift = filled
             difference[rows[revealed], cols[revealed]] = after.change(rho, found.radiance)
-            edited = lifted(radiance, difference[rows, cols], lift)
+            change = lifted(radiance, difference[rows, cols], lift)
             surface = found.panorama.maps.surface_without.copy()  # the surfaces as the fill took them
             surface[revealed] = solution.target.surface_key[found.tri]
-            difference[rows, cols] = seamless_block_change(radiance, edited, revealed, surface)
+            difference[rows, cols] = seamless_block_change(radiance, change, revealed, surface)
     unseen = int(window.hidden.sum() - revealed.sum())
     if unseen:
         rep.warn(f"{unseen} pixels of the object see no proxy geometry behind it; they are left unchanged")
