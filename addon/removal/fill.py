@@ -12,7 +12,7 @@ from ..callbacks import RunCallbacks
 from ..geometry import latlong
 from ..geometry.mesh import Geometry, surfaces_of
 from ..geometry.planeraster import Frame, edge_direction
-from ..light.radiosity import RHO_MAX
+from ..light.radiosity import LUMA, RHO_MAX
 from ..report import Report
 from ..side_by_side import each
 from ..synthesis.material import Material
@@ -92,7 +92,7 @@ def filled_reflectance(solution: Solution, revealed: Revealed, rep: Report, call
                        show: Callable[[np.ndarray], None] | None = None) -> tuple[np.ndarray, np.ndarray | None]:
     """(K, 3) the reflectance of the revealed pixels, synthesised surface by surface (each
     patch's mean reflectance where a surface is too little seen); and over the pixels of
-    `revealed.panorama`, the factor (h, w) that lifts the object's shadow the relighting left
+    `revealed.panorama`, the factor (h, w, 3) that lifts the object's shadow the relighting left
     darker than its surface beside the hole (`shadow_lift`; None where there is none). It needs
     no light, so a full-resolution removal computes the light after the removal meanwhile.
     `show(rho)` gets it as `fill_hidden`'s `show` says."""
@@ -161,13 +161,13 @@ def filled_reflectance(solution: Solution, revealed: Revealed, rep: Report, call
 
 def lifted(radiance: np.ndarray, change: np.ndarray, lift: np.ndarray | None) -> np.ndarray:
     """`change` (h, w, 3) of `radiance` (h, w, 3) with the edited radiance multiplied by `lift`
-    (h, w; `filled_reflectance`) where it is above 1."""
+    (h, w, 3; `filled_reflectance`) where it is above 1."""
     if lift is None:
         return change
     out = np.array(change, copy=True)
-    at = lift > 1
+    at = (lift > 1).any(axis=-1)
     photographed = np.maximum(radiance[at], 0.0)
-    out[at] = (photographed + change[at]) * lift[at, None] - photographed
+    out[at] = (photographed + change[at]) * lift[at] - photographed
     return out
 
 
@@ -373,4 +373,15 @@ def _panorama_reflectance(solution: Solution, radiance: np.ndarray, edges: Surfa
     rho[pixel] = across.rho
     maps = PanoramaMaps(surface_with.reshape(shape), distance_with.reshape(shape), surface_without.reshape(shape),
                         distance_without.reshape(shape), traced.hidden_map)
-    return PanoramaReflectance(rho.reshape(*shape, 3), valid.reshape(shape), maps)
+    relit = np.ones(n, np.float32)
+    relit[traced.hp] = relit_ratio(e_h, solution.de_h)
+    return PanoramaReflectance(rho.reshape(*shape, 3), valid.reshape(shape), maps, relit.reshape(shape))
+
+
+def relit_ratio(before: np.ndarray, change: np.ndarray) -> np.ndarray:
+    """(...) the relighting's change of light E' / E in luminance, from E (..., 3) and its change,
+    or from the radiance and its ratio-form change; 1 where `before` is 0."""
+    luma = LUMA.astype(np.float32)
+    b = before @ luma
+    positive = b > 0
+    return np.where(positive, (b + change @ luma) / np.where(positive, b, 1), 1).astype(np.float32)

@@ -36,6 +36,7 @@ from .fill import (
     measured_reflectance,
     moved_across,
     onto_photographed,
+    relit_ratio,
     surface_edges,
     surface_footprint,
 )
@@ -127,7 +128,8 @@ def full_resolution(solution: Solution, hdri: np.ndarray, rep: Report, callbacks
     found = None
     if revealed.any():
         with rep.stage("hidden_light"):
-            found = _revealed(solution, window, window_e, radiance, surfaces, revealed)
+            found = _revealed(solution, window, window_e, radiance, surfaces, revealed,
+                              relit=relit_ratio(radiance, difference[rows, cols]))
 
     def synthesis() -> tuple[np.ndarray, np.ndarray | None] | None:
         """The revealed pixels' reflectance and the lift of the object's shadow beside them
@@ -514,11 +516,12 @@ def _window_surfaces(solution: Solution, window: ObjectWindow, window_e: np.ndar
 
 
 def _revealed(solution: Solution, window: ObjectWindow, window_e: np.ndarray, radiance: np.ndarray,
-              surfaces: _WindowSurfaces, revealed: np.ndarray) -> Revealed:
-    """The window's revealed pixels and its reflectance measured from its `radiance` (h, w, 3),
-    at full resolution (float32: the maps span millions of pixels). As on the working panorama
-    (`fill.working_revealed`), the pixels between a proxy's surface edge and the photograph's
-    are on the surface the photograph shows there, revealed and seen alike."""
+              surfaces: _WindowSurfaces, revealed: np.ndarray, *, relit: np.ndarray) -> Revealed:
+    """The window's revealed pixels and its reflectance measured from its `radiance` (h, w, 3)
+    (`relit`, h, w: the relighting's change of light there, E' / E), at full resolution (float32:
+    the maps span millions of pixels). As on the working panorama (`fill.working_revealed`), the
+    pixels between a proxy's surface edge and the photograph's are on the surface the photograph
+    shows there, revealed and seen alike."""
     frame = window.frame
     rows, cols = _window_pixels(window)
     keys = solution.target.surface_key.astype(np.int32)
@@ -541,7 +544,7 @@ def _revealed(solution: Solution, window: ObjectWindow, window_e: np.ndarray, ra
     solid = latlong.pixel_solid_angles(frame.width, frame.height)[rows[revealed], 0]
     footprint = surface_footprint(solid, directions, solution.geo.normals[tri], np.linalg.norm(points, axis=1))
     return Revealed(tri=tri, bary=bary, points=points, radiance=radiance[revealed].astype(np.float64),
-                    footprint=footprint, panorama=PanoramaReflectance(rho, measured, maps), edges=edges)
+                    footprint=footprint, panorama=PanoramaReflectance(rho, measured, maps, relit), edges=edges)
 
 
 def _move_across(solution: Solution, edges: SurfaceEdges, maps: PanoramaMaps, rho: np.ndarray, radiance: np.ndarray,

@@ -68,6 +68,7 @@ _HALO_DARKER = 0.7
 _HALO_QUANTILE = 0.05
 _HALO_BELOW = 0.85
 _HALO_SMOOTH = 0.15
+RELIT = 1.05  # E' / E above this: the relighting brightens the cell, beyond the room's general gain
 # Cells the panorama resolves far more coarsely than the hole (the floor beyond it, seen at a
 # more grazing angle) hold the texture blurred and stretched along the rays, and on a glossy
 # floor another sheen: copied cell by cell into the hole near the probe they made the real
@@ -97,11 +98,14 @@ class Material:
     share: float  # exemplar cells / known cells
     decided: bool = True  # False: too little is seen around the hole to tell its material
     # of `replaced`, the object's shadow left darker than the material; the cells past it that
-    # are its penumbra (`_shadow_halo`); and the material's cells around the hole it was judged
-    # against; None where the material is not told by its border
+    # are its penumbra (`_shadow_halo`); the material's cells around the hole it was judged
+    # against; and the cells near the hole in the colours of the material's shadows that are
+    # not in the shadow (the floor beside it, exemplar or not); None where the material is not
+    # told by its border
     shadow: np.ndarray | None = None
     penumbra: np.ndarray | None = None
     around: np.ndarray | None = None
+    beside: np.ndarray | None = None
 
     @property
     def mostly_other(self) -> bool:
@@ -110,9 +114,12 @@ class Material:
         return self.decided and (self.source == "whole surface" or self.share < _MIN_SHARE_WARN)
 
 
-def border_material(image: np.ndarray, known: np.ndarray, hole: np.ndarray, *, min_cells: int) -> Material:
+def border_material(image: np.ndarray, known: np.ndarray, hole: np.ndarray, *, min_cells: int,
+                    relit: np.ndarray | None = None) -> Material:
     """The cells of `image` (h, w, 3 reflectance) among `known` whose material surrounds `hole`;
-    the whole of `known` where fewer than `min_cells` match."""
+    the whole of `known` where fewer than `min_cells` match. `relit` (h, w): the relighting's own
+    change of light on each cell (E' / E), which tells the object's shadow from a surface's
+    darkening by something else (`_shadow_halo`); without it every cell counts as relit."""
     undecided = Material(exemplar=known, replaced=np.zeros_like(known), source="whole surface", share=1.0,
                          decided=False)
     if not hole.any():
@@ -178,13 +185,15 @@ def border_material(image: np.ndarray, known: np.ndarray, hole: np.ndarray, *, m
     # where it is seen there
     around = exemplar & rings[1][0]
     around = around if around.any() else exemplar & near
-    halo, penumbra = _shadow_halo(mean, log_y, known, around, hole, reach // 2)
+    relit_cells = known if relit is None else known & (relit > RELIT)
+    halo, penumbra, beside = _shadow_halo(mean, log_y, known, around, hole, reach // 2, relit=relit_cells)
     exemplar &= ~dilate(halo, 1)
     if exemplar.sum() < min_cells:
         return replace(undecided, decided=True)
     # Only what is wider than a line is repainted beside the hole: a thin stripe is only left out.
     return Material(exemplar=exemplar, replaced=(near & wide) | halo, source="border material",
-                    share=float(exemplar.sum() / known.sum()), shadow=halo, penumbra=penumbra, around=around)
+                    share=float(exemplar.sum() / known.sum()), shadow=halo, penumbra=penumbra, around=around,
+                    beside=beside)
 
 
 def ring_widths(hole: np.ndarray) -> tuple[int, int]:
@@ -243,28 +252,51 @@ def _dark_clutter(log_y: np.ndarray, candidates: np.ndarray, band: np.ndarray) -
 
 
 def _shadow_halo(mean: np.ndarray, log_y: np.ndarray, known: np.ndarray, material: np.ndarray, hole: np.ndarray,
-                 reach: int) -> tuple[np.ndarray, np.ndarray]:
+                 reach: int, *, relit: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(h, w) the `known` cells within `reach` of `hole` joined to it through cells of the
     object's shadow left darker than the `material` cells (the caller's, beyond `reach` where it
-    sees any there): `mean`
-    (`colour_features`) below `_HALO_DARKER` of their median and `_HALO_BELOW` of their
-    `_HALO_QUANTILE`, in their chromaticity and smooth (`log_y`: log luminance). The fill is not
-    to continue it. And (h, w) its penumbra: the cells within `reach` past it, in that
-    chromaticity, smooth and below the median."""
+    sees any there): `mean` (`colour_features`) below `_HALO_DARKER` of their median and
+    `_HALO_BELOW` of their `_HALO_QUANTILE`, in the colours their shadow takes
+    (`_shadow_colours`) and smooth (`log_y`: log luminance). The fill is not to continue it. And
+    (h, w) its penumbra: the cells within `reach` past it, in those colours, smooth, below the
+    median and brightened by the relighting (`relit`, h, w): a floor darkened by a wall beside it
+    takes a shadow's colours too, but the object's removal does not change its light. And (h, w)
+    the cells in those colours within twice `reach` of the hole that are neither, nor darker than
+    the shadow's bound: the floor beside the shadow, which the material's cells may not be (a
+    glossy floor's nearer side, more saturated, is not found all around the hole)."""
     if not material.any():
-        return np.zeros_like(hole), np.zeros_like(hole)
+        return np.zeros_like(hole), np.zeros_like(hole), np.zeros_like(hole)
     levels = mean[..., 0][material]
     level = min(np.median(levels) + np.log(_HALO_DARKER), np.quantile(levels, _HALO_QUANTILE) + np.log(_HALO_BELOW))
-    chroma = np.median(mean[..., 1:][material], axis=0)
     square, _ = box_mean((log_y**2)[..., None], known, 1)
     deviation = np.sqrt(np.maximum(square[..., 0] - mean[..., 0] ** 2, 0.0))
-    alike = known & (np.abs(mean[..., 1:] - chroma).max(axis=-1) < _STEPS[1]) & (deviation < _HALO_SMOOTH)
-    shade = alike & dilate(hole, reach) & (mean[..., 0] < level)
+    alike = known & _shadow_colours(mean[..., 1:], np.median(mean[..., 1:][material], axis=0)) & (
+        deviation < _HALO_SMOOTH)
+    shade = alike & relit & dilate(hole, reach) & (mean[..., 0] < level)
     labels, _ = components(shade | hole)
     halo = shade & np.isin(labels, np.unique(labels[hole]))
-    # its penumbra: the cells past it, as far again, in its colour, smooth and darker than the median
-    penumbra = alike & dilate(halo, reach) & ~halo & (mean[..., 0] < np.median(levels)) if halo.any() else halo
-    return halo, penumbra
+    # its penumbra: the cells past it, as far again, in its colours, smooth, darker than the
+    # median and relit
+    penumbra = alike & relit & dilate(halo, reach) & ~halo & (mean[..., 0] < np.median(levels)) if halo.any() else halo
+    beside = alike & dilate(hole, 2 * reach) & ~halo & ~penumbra & (mean[..., 0] >= level)
+    return halo, penumbra, beside
+
+
+def _shadow_colours(chroma: np.ndarray, material: np.ndarray) -> np.ndarray:
+    """(h, w) bool: whether each chromaticity (r, g) of `chroma` (h, w, 2) is one a shadow on a
+    surface of chromaticity `material` (2,) takes, within one step.
+
+    The light left in a shadow is mostly what the surface around it reflects into it, so it
+    comes in the surface's colour after one more bounce (its rgb squared) as well as in the
+    light's: the shadow's chromaticity lies between the surface's and that of the surface's
+    colour times itself. On a warm wood floor it is more saturated than the floor: the real
+    lobby bench's residual shadow under its box proxy has r 0.53-0.55 against the floor's
+    0.48-0.50, and within one step of the floor's chromaticity alone 8 of its cells passed for
+    shadow (1.5 % of the hole's border, too few to lift)."""
+    rgb = np.append(material, 1.0 - material.sum())
+    bounced = (rgb**2 / max(float((rgb**2).sum()), 1e-12))[:2] - material
+    t = np.clip(((chroma - material) @ bounced) / max(float(bounced @ bounced), 1e-12), 0.0, 1.0)
+    return np.abs(chroma - material - t[..., None] * bounced).max(axis=-1) < _STEPS[1]
 
 
 def _directions(flat: np.ndarray, shape: tuple[int, ...], ring: np.ndarray, centre: tuple[float, float]

@@ -66,11 +66,15 @@ class PanoramaMaps:
 @dataclass(frozen=True)
 class PanoramaReflectance:
     """What the panorama tells about reflectance: (h, w, 3) rho = pi L / E, (h, w) where it
-    was measured, and the surfaces each pixel sees, over the pixels of the maps' frame."""
+    was measured, the surfaces each pixel sees, and how the removal changes its light, over the
+    pixels of the maps' frame."""
 
     rho: np.ndarray
     valid: np.ndarray
     maps: PanoramaMaps
+    # (h, w) the relighting's change of light at each pixel (E' / E); None: not known (taken as
+    # relit everywhere)
+    relit: np.ndarray | None = None
 
     def shows(self, surface: int) -> np.ndarray:
         """(h, w) where the reflectance is measured on `surface` (seen first there: not where
@@ -114,13 +118,14 @@ class SurfaceFill:
     material: Material  # which seen cells served as exemplar
     structured: int = 0  # hole cells composed from shifted copies (the rest: order-independent synthesis)
     band_cells: int = 0  # hole cells of a band continued across the hole (`crossing`)
-    # (h, w) over the panorama maps' pixels, the factor that lifts the object's shadow the
-    # relighting left darker than this surface beside the hole (`shadow_lift`); None: no such shadow
+    # (h, w, 3) over the panorama maps' pixels, the factor per channel that lifts the object's
+    # shadow the relighting left darker than this surface beside the hole (`shadow_lift`); None:
+    # no such shadow
     lift: np.ndarray | None = None
 
     @property
     def lifted_pixels(self) -> int:
-        return 0 if self.lift is None else int((self.lift > 1).sum())
+        return 0 if self.lift is None else int((self.lift > 1).any(axis=-1).sum())
 
 
 def fill_surface(
@@ -156,7 +161,10 @@ def fill_surface(
     # A wall's hole is continued column by column from the wall itself (`wall_columns`): what the
     # photograph shows on it beside the hole (a door, a dark panel) is no clutter to leave out.
     wall = planeraster.is_wall(plane.normal)
-    material = wall_material(known) if wall else border_material(values, known, hole, min_cells=_MIN_KNOWN)
+    relit = None if wall or panorama.relit is None else planeraster.sample_panorama(
+        raster, panorama.relit[..., None], panorama.shows(plane.surface), frame=maps.frame)[0][..., 0]
+    material = wall_material(known) if wall else border_material(values, known, hole, min_cells=_MIN_KNOWN,
+                                                                 relit=relit)
     crossing = find_crossing(values, known, hole) if options.structure and not wall else None
     if crossing is not None:  # each colour is copied only into its own region: nothing to repaint
         material = replace(material, replaced=np.zeros_like(material.replaced))
@@ -165,13 +173,13 @@ def fill_surface(
     exemplar, to_fill = material.exemplar, hole | material.replaced
     lift = None
     if not wall and crossing is None:  # a wall's columns and a band's regions are continued as they are
-        gain = shadow_gain(values, known, material, hole)
+        gain = shadow_gain(values, known, material, hole, relit=relit)
         if gain is not None:
             # the fill meets, and copies from, the surface as the lifted photograph shows it
             lift = _lift(panorama, plane, raster, gain)
-            values = values * gain[..., None]
+            values = values * gain
             if lift is not None:
-                panorama = replace(panorama, rho=panorama.rho * lift[..., None])
+                panorama = replace(panorama, rho=panorama.rho * lift)
     mean = values[exemplar].mean(axis=0) if exemplar.any() else np.zeros(3)
     image = np.where(exemplar[..., None], values, mean)
     filled = None
@@ -223,12 +231,13 @@ def _seen_points(panorama: PanoramaReflectance, rows: np.ndarray, cols: np.ndarr
 
 def _lift(panorama: PanoramaReflectance, plane: HiddenPlane, raster: planeraster.PlaneRaster, gain: np.ndarray
           ) -> np.ndarray | None:
-    """(h, w) over the panorama maps' pixels, the raster's `gain` (`shadow_lift.shadow_gain`) at
-    the pixels that show the plane's surface, 1 elsewhere; None where it lifts none of them."""
+    """(h, w, 3) over the panorama maps' pixels, the raster's `gain` (h, w, 3:
+    `shadow_lift.shadow_gain`) at the pixels that show the plane's surface, 1 elsewhere; None
+    where it lifts none of them."""
     rows, cols = np.nonzero(panorama.shows(plane.surface))
     points, inside = _seen_points(panorama, rows, cols, raster)
-    lift = np.ones(panorama.valid.shape, np.float32)
-    lift[rows[inside], cols[inside]] = planeraster.sample_raster(raster, gain[..., None], points[inside])[:, 0]
+    lift = np.ones((*panorama.valid.shape, 3), np.float32)
+    lift[rows[inside], cols[inside]] = planeraster.sample_raster(raster, gain, points[inside])
     return lift if (lift > 1).any() else None
 
 

@@ -266,13 +266,13 @@ def test_a_cancel_stops_the_lighting_between_stages():
     assert not issubclass(Cancelled, DimredError)
 
 
-def test_the_shadow_lift_multiplies_the_edited_radiance_where_it_is_above_one():
+def test_the_shadow_lift_multiplies_the_edited_radiance_per_channel_where_it_is_above_one():
     radiance = np.full((2, 3, 3), 0.5, np.float32)
     change = np.full((2, 3, 3), 0.1, np.float32)
-    lift = np.ones((2, 3), np.float32)
-    lift[0, 1] = 2.0
+    lift = np.ones((2, 3, 3), np.float32)
+    lift[0, 1] = (2.0, 1.5, 1.0)
     got = fill.lifted(radiance, change, lift)
-    np.testing.assert_allclose(got[0, 1], (0.5 + 0.1) * 2 - 0.5)
+    np.testing.assert_allclose(got[0, 1], (0.5 + 0.1) * np.array([2.0, 1.5, 1.0]) - 0.5, rtol=1e-6)
     unlifted = np.ones((2, 3), bool)
     unlifted[0, 1] = False
     np.testing.assert_array_equal(got[unlifted], change[unlifted])

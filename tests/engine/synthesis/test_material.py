@@ -4,7 +4,14 @@ from __future__ import annotations
 import numpy as np
 
 from addon.segmentation.masks import dilate
-from addon.synthesis.material import _shadow_halo, border_material, colour_features, log_luminance, sharp_exemplar
+from addon.synthesis.material import (
+    _shadow_colours,
+    _shadow_halo,
+    border_material,
+    colour_features,
+    log_luminance,
+    sharp_exemplar,
+)
 
 _H, _W = 120, 160
 
@@ -197,11 +204,23 @@ def test_a_fine_print_as_dark_beside_the_hole_is_no_shadow() -> None:
         image = floor * np.where(print_ & (np.arange(_W) % 2 == 0)[None, :], 0.4, shade)[..., None]
         log_y = log_luminance(image)
         mean = colour_features(image, log_y, ~hole, radius=1)
-        halo, _ = _shadow_halo(mean, log_y, ~hole, ~hole & (shade == 1) & ~print_ & dilate(hole, 16), hole, 8)
+        halo, _, _ = _shadow_halo(mean, log_y, ~hole, ~hole & (shade == 1) & ~print_ & dilate(hole, 16), hole, 8,
+                               relit=~hole)
         if printed:
             assert not halo[print_].any()
         else:
             assert halo[(shade < 0.7) & dilate(hole, 8)].mean() > 0.9
+
+
+def test_a_shadow_takes_the_colours_between_its_surfaces_and_its_surfaces_bounced() -> None:
+    """The light left in a shadow is the surface's own, bounced: a warm floor's shadow is more
+    saturated than the floor, up to the floor's colour squared; it is not bluer, nor another hue."""
+    rgb = np.array([0.45, 0.30, 0.18])
+    chroma = lambda x: (x / x.sum())[:2]  # noqa: E731
+    floor = chroma(rgb)
+    cells = np.array([[floor, chroma(rgb**1.5), chroma(rgb**2), chroma(rgb**0.5), chroma(rgb[::-1]),
+                       chroma(np.array([0.30, 0.45, 0.18]))]])
+    assert _shadow_colours(cells, floor).tolist() == [[True, True, True, False, False, False]]
 
 
 def _footprint() -> np.ndarray:

@@ -28,7 +28,7 @@ def test_the_shadow_left_beside_the_hole_is_brought_to_the_floors_level_its_grai
     material = border_material(image, ~hole, hole, min_cells=64)
     assert material.shadow is not None and material.shadow.any()
     gain = shadow_gain(image, ~hole, material, hole)
-    lifted = (image * gain[..., None]) @ LUMA
+    lifted = (image * gain) @ LUMA
     level = np.median((floor @ LUMA)[~hole])
     # (the test's shadow ends sideways in a hard edge, which a 5x5 level blurs: its inside)
     deep = (shade < 0.5) & ~hole & dilate(hole, 6) & (np.abs(np.arange(_W) - 75) <= 14)[None, :]
@@ -59,3 +59,87 @@ def test_a_few_dark_cells_beside_the_hole_are_the_floors_own_not_lifted() -> Non
     few[74:76, 74:77] = material.shadow[74:76, 74:77]  # six cells along a border of about a hundred
     assert few.any()
     assert shadow_gain(image, ~hole, replace(material, shadow=few), hole) is None
+
+
+def _bounced(shade: np.ndarray, floor: np.ndarray) -> np.ndarray:
+    """`floor` (h, w, 3) darkened by `shade` (h, w), the light left in the shade the floor's own,
+    bounced: its colour goes from the floor's halfway to the floor's colour squared as it darkens
+    to half."""
+    tint = np.array([0.45, 0.30, 0.18]) / 0.45
+    depth = (1 - shade)[..., None] / 0.5
+    return floor * shade[..., None] * tint ** (0.5 * np.clip(depth, 0.0, 1.0))
+
+
+def test_a_shadow_in_the_floors_bounced_colour_is_lifted_to_the_floors_colour() -> None:
+    """The light left in a shadow is the floor's own, bounced: the shadow is more saturated
+    than the floor. It is taken for shadow and lifted per channel, so it takes the floor's
+    colour, not only its level (one factor left a warm floor's shadow an orange strip)."""
+    hole = _hole()
+    shade = _shade(0.5)
+    floor = _floor(7)
+    image = _bounced(shade, floor)
+    material = border_material(image, ~hole, hole, min_cells=64)
+    assert material.shadow is not None and material.shadow.sum() > 200
+    gain = shadow_gain(image, ~hole, material, hole)
+    assert gain is not None
+    deep = (shade < 0.6) & ~hole & dilate(hole, 6) & (np.abs(np.arange(_W) - 75) <= 14)[None, :]
+    chroma = lambda x: x / x.sum(axis=-1, keepdims=True)  # noqa: E731
+    want = np.median(chroma(floor[~hole]), axis=0)
+    before = np.median(chroma(image[deep]), axis=0)
+    after = np.median(chroma((image * gain)[deep]), axis=0)
+    assert np.abs(before - want).max() > 0.04
+    assert np.abs(after - want).max() < 0.01
+
+
+def test_a_darkening_the_relighting_does_not_brighten_is_not_lifted() -> None:
+    """A floor darkened beside the hole by something else (a wall's shade, in the floor's
+    bounced colour like a shadow) is no shadow of the object: where the relighting does not
+    brighten it (E' / E about 1), nothing is lifted."""
+    hole = _hole()
+    image = _bounced(_shade(0.5), _floor(8))
+    unchanged = np.ones((_H, _W))
+    material = border_material(image, ~hole, hole, min_cells=64, relit=unchanged)
+    assert material.shadow is None or not material.shadow.any()
+    assert shadow_gain(image, ~hole, material, hole) is None
+    # relit only within 4 rows of the hole: the shadow stops there, and its penumbra with it
+    relit = np.where(np.indices((_H, _W))[0] < 78, 1.5, 1.0)
+    material = border_material(image, ~hole, hole, min_cells=64, relit=relit)
+    gain = shadow_gain(image, ~hole, material, hole)
+    assert gain is not None and (gain[74:78] > 1).any()
+    assert np.all(gain[78:] == 1.0)
+
+
+def test_the_shadow_is_lifted_to_the_floor_beside_it_not_to_the_floors_median() -> None:
+    """A glossy floor seen farther away is paler: the shadow below the hole is lifted to the
+    floor below it, not to the median of the floor all around."""
+    hole = _hole()
+    shade = _shade(0.4)
+    rows = np.indices((_H, _W))[0]
+    floor = _floor(9) * np.where(rows < 62, 1.4, 1.0)[..., None]  # the far side, above, paler
+    image = floor * shade[..., None]
+    material = border_material(image, ~hole, hole, min_cells=64)
+    gain = shadow_gain(image, ~hole, material, hole)
+    assert gain is not None
+    deep = (shade < 0.5) & ~hole & dilate(hole, 6) & (np.abs(np.arange(_W) - 75) <= 14)[None, :]
+    near = np.median((floor @ LUMA)[(rows > 90) & ~hole])
+    assert abs(np.median(((image * gain) @ LUMA)[deep]) / near - 1) < 0.08
+
+
+def test_a_shadow_far_deeper_than_the_relighting_made_it_is_lifted_no_more_than_its_square() -> None:
+    """A box for an armchair shades less than the armchair, but not far less: a cell the proxy
+    hardly shades (E' / E of 1.1) that is half the floor's level is something else's shadow or
+    paint, lifted at most by the relighting's change squared. Where the proxy shades it deeply,
+    it is lifted to the floor."""
+    hole = _hole()
+    shade = _shade(0.5)
+    image = _floor(10) * shade[..., None]
+    deep = (shade < 0.6) & ~hole & dilate(hole, 6) & (np.abs(np.arange(_W) - 75) <= 14)[None, :]
+    lifts = {}
+    for change in (1.1, 2.5):
+        relit = np.full((_H, _W), change)
+        material = border_material(image, ~hole, hole, min_cells=64, relit=relit)
+        gain = shadow_gain(image, ~hole, material, hole, relit=relit)
+        assert gain is not None
+        lifts[change] = np.median((gain @ LUMA)[deep])
+    assert lifts[1.1] <= 1.1**2 + 1e-6
+    assert lifts[2.5] > 1.6
