@@ -78,4 +78,10 @@ def shadow_gain(values: np.ndarray, known: np.ndarray, material: Material, hole:
     weight = shadow.astype(np.float64)
     for step in range(1, fade + 1):
         weight = np.maximum(weight, (1 - step / (fade + 1)) * (dilate(shadow, step) & material.penumbra))
-    return np.where(known[..., None], 1 + (deficit - 1) * weight[..., None], 1.0)
+    gain = np.where(known[..., None], 1 + (deficit - 1) * weight[..., None], 1.0)
+    # A pixel right outside the fill is looked up between the hole's cells and the shadow's: the
+    # hole's cells beside the shadow take its gain, or the first row of pixels is lifted half way
+    # and shows as a dotted dark line along the fill.
+    lifted = known & (weight > 0)
+    beside_hole, count = box_mean(gain, lifted, 1)
+    return np.where((~known & (count > 0))[..., None], beside_hole, gain)

@@ -143,3 +143,21 @@ def test_a_shadow_far_deeper_than_the_relighting_made_it_is_lifted_no_more_than_
         lifts[change] = np.median((gain @ LUMA)[deep])
     assert lifts[1.1] <= 1.1**2 + 1e-6
     assert lifts[2.5] > 1.6
+
+
+def test_the_holes_cells_beside_the_shadow_carry_its_lift_for_the_pixels_between() -> None:
+    """The panorama's pixels right outside the fill are looked up between the hole's cells and
+    the shadow's: the hole's cells beside the shadow carry its gain, so those pixels are lifted
+    as much as the shadow (half as much, they showed as a dotted dark line along the fill)."""
+    hole = _hole()
+    shade = _shade(0.4)
+    image = _floor(11) * shade[..., None]
+    material = border_material(image, ~hole, hole, min_cells=64)
+    gain = shadow_gain(image, ~hole, material, hole)
+    assert gain is not None
+    edge = hole & dilate(material.shadow, 1)
+    assert edge.any()
+    inside = (gain @ LUMA)[edge]
+    outside = (gain @ LUMA)[dilate(edge, 1) & material.shadow]
+    assert np.median(inside) > 0.9 * np.median(outside) > 1.5
+    assert np.all(gain[hole & ~dilate(~hole, 1)] == 1.0)  # deeper in the hole nothing is carried
