@@ -55,15 +55,17 @@ _MIN_SHARE_WARN = 0.5  # below this share of the seen cells, the surface is most
 # The object's shadow right beside the hole where the relighting leaves it darker than its surface
 # (a box proxy's shadow is not the armchair's): cells joined to the hole, within half the ring,
 # through cells darker than `_HALO_DARKER` of the material's median beyond that reach and than
-# `_HALO_BELOW` of its `_HALO_QUANTILE` there, in its chromaticity (within one step) and smooth
-# (3x3 deviation of log luminance below `_HALO_SMOOTH`). Continued inward, it made the bottom of
-# the real hotel armchair's fill a dark patch (245 cells there, at 0.8-1 times the quantile
-# alike). The last three tell it from the material or paint: a checker's dark tiles are as dark
-# as the material's darkest beyond, and the exact proxy's shadow on them is relit to within a
-# few percent (at the quantile itself tile_stool's were taken for shadow, 153 cells, and its fill
-# without structure rose from 0.171 to 0.203 total error; basic_box's mean error from 0.000 to
-# 0.016 at the median's 0.7 alone); a rug's stripes passing under the object are crisp (without
-# the chromaticity and smoothness hotel_rug_box's mean error rose from 0.07 to 0.38).
+# `_HALO_BELOW` of its `_HALO_QUANTILE` there, in the colours a shadow on it takes
+# (`_shadow_colours`), smooth (3x3 deviation of log luminance below `_HALO_SMOOTH`) and brightened
+# by the relighting (E' / E above `RELIT`). Continued inward, it made the bottom of the real hotel
+# armchair's fill a dark patch (245 cells there, at 0.8-1 times the quantile alike). The
+# quantile, the colours and the smoothness tell it from the material or paint: a checker's dark
+# tiles are as dark as the material's darkest beyond, and the exact proxy's shadow on them is
+# relit to within a few percent (at the quantile itself tile_stool's were taken for shadow, 153
+# cells, and its fill without structure rose from 0.171 to 0.203 total error; basic_box's mean
+# error from 0.000 to 0.016 at the median's 0.7 alone); a rug's stripes passing under the object
+# are crisp (without the chromaticity and smoothness hotel_rug_box's mean error rose from 0.07 to
+# 0.38).
 _HALO_DARKER = 0.7
 _HALO_QUANTILE = 0.05
 _HALO_BELOW = 0.85
@@ -185,8 +187,8 @@ def border_material(image: np.ndarray, known: np.ndarray, hole: np.ndarray, *, m
     # where it is seen there
     around = exemplar & rings[1][0]
     around = around if around.any() else exemplar & near
-    relit_cells = known if relit is None else known & (relit > RELIT)
-    halo, penumbra, beside = _shadow_halo(mean, log_y, known, around, hole, reach // 2, relit=relit_cells)
+    brightened = known if relit is None else known & (relit > RELIT)
+    halo, penumbra, beside = _shadow_halo(mean, log_y, known, around, hole, reach // 2, brightened=brightened)
     exemplar &= ~dilate(halo, 1)
     if exemplar.sum() < min_cells:
         return replace(undecided, decided=True)
@@ -252,18 +254,19 @@ def _dark_clutter(log_y: np.ndarray, candidates: np.ndarray, band: np.ndarray) -
 
 
 def _shadow_halo(mean: np.ndarray, log_y: np.ndarray, known: np.ndarray, material: np.ndarray, hole: np.ndarray,
-                 reach: int, *, relit: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                 reach: int, *, brightened: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(h, w) the `known` cells within `reach` of `hole` joined to it through cells of the
     object's shadow left darker than the `material` cells (the caller's, beyond `reach` where it
     sees any there): `mean` (`colour_features`) below `_HALO_DARKER` of their median and
     `_HALO_BELOW` of their `_HALO_QUANTILE`, in the colours their shadow takes
-    (`_shadow_colours`) and smooth (`log_y`: log luminance). The fill is not to continue it. And
-    (h, w) its penumbra: the cells within `reach` past it, in those colours, smooth, below the
-    median and brightened by the relighting (`relit`, h, w): a floor darkened by a wall beside it
-    takes a shadow's colours too, but the object's removal does not change its light. And (h, w)
-    the cells in those colours within twice `reach` of the hole that are neither, nor darker than
-    the shadow's bound: the floor beside the shadow, which the material's cells may not be (a
-    glossy floor's nearer side, more saturated, is not found all around the hole)."""
+    (`_shadow_colours`), smooth (`log_y`: log luminance) and brightened by the relighting
+    (`brightened`, h, w): a floor darkened by a wall beside it takes a shadow's colours too, but
+    the object's removal does not change its light. The fill is not to continue it. And (h, w)
+    its penumbra: the cells within `reach` past it, in those colours, smooth, brightened and
+    below the median. And (h, w) the cells in those colours within twice `reach` of the hole that
+    are neither, nor darker than the shadow's bound: the floor beside the shadow, which the
+    material's cells may not be (a glossy floor's nearer side, more saturated, is not found all
+    around the hole)."""
     if not material.any():
         return np.zeros_like(hole), np.zeros_like(hole), np.zeros_like(hole)
     levels = mean[..., 0][material]
@@ -272,12 +275,13 @@ def _shadow_halo(mean: np.ndarray, log_y: np.ndarray, known: np.ndarray, materia
     deviation = np.sqrt(np.maximum(square[..., 0] - mean[..., 0] ** 2, 0.0))
     alike = known & _shadow_colours(mean[..., 1:], np.median(mean[..., 1:][material], axis=0)) & (
         deviation < _HALO_SMOOTH)
-    shade = alike & relit & dilate(hole, reach) & (mean[..., 0] < level)
+    shade = alike & brightened & dilate(hole, reach) & (mean[..., 0] < level)
     labels, _ = components(shade | hole)
     halo = shade & np.isin(labels, np.unique(labels[hole]))
-    # its penumbra: the cells past it, as far again, in its colours, smooth, darker than the
-    # median and relit
-    penumbra = alike & relit & dilate(halo, reach) & ~halo & (mean[..., 0] < np.median(levels)) if halo.any() else halo
+    # its penumbra: the cells past it, as far again, in its colours, smooth, brightened and darker
+    # than the median
+    below = mean[..., 0] < np.median(levels)
+    penumbra = alike & brightened & dilate(halo, reach) & ~halo & below if halo.any() else halo
     beside = alike & dilate(hole, 2 * reach) & ~halo & ~penumbra & (mean[..., 0] >= level)
     return halo, penumbra, beside
 

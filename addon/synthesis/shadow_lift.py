@@ -82,6 +82,5 @@ def shadow_gain(values: np.ndarray, known: np.ndarray, material: Material, hole:
     # A pixel right outside the fill is looked up between the hole's cells and the shadow's: the
     # hole's cells beside the shadow take its gain, or the first row of pixels is lifted half way
     # and shows as a dotted dark line along the fill.
-    lifted = known & (weight > 0)
-    beside_hole, count = box_mean(gain, lifted, 1)
-    return np.where((~known & (count > 0))[..., None], beside_hole, gain)
+    carried, lifted_near = box_mean(gain, known & (weight > 0), 1)
+    return np.where((~known & (lifted_near > 0))[..., None], carried, gain)

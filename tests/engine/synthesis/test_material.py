@@ -205,7 +205,7 @@ def test_a_fine_print_as_dark_beside_the_hole_is_no_shadow() -> None:
         log_y = log_luminance(image)
         mean = colour_features(image, log_y, ~hole, radius=1)
         halo, _, _ = _shadow_halo(mean, log_y, ~hole, ~hole & (shade == 1) & ~print_ & dilate(hole, 16), hole, 8,
-                               relit=~hole)
+                                  brightened=~hole)
         if printed:
             assert not halo[print_].any()
         else:
