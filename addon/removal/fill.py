@@ -75,27 +75,40 @@ def hidden_light(solution: Solution, revealed: Revealed, callbacks: RunCallbacks
     return HiddenLight(e_after=np.maximum(e_after, 0.0), emit=emit, emitted=emitted)
 
 
+@dataclass(frozen=True)
+class FilledReflectance:
+    """The revealed pixels' synthesised reflectance and what the seam and the shadow's lift need
+    to know of how it was made."""
+
+    rho: np.ndarray  # (K, 3)
+    # over the pixels of the revealed panorama, the factor (h, w, 3) that lifts the object's
+    # shadow the relighting left darker than its surface beside the hole (`shadow_lift`); None
+    # where there is none
+    lift: np.ndarray | None
+    # (K,) bool: on a plane whose fill continues the photograph's structure from copies: mostly a
+    # tiling's or planks' shifted copies, or a wall's columns
+    continued: np.ndarray
+
+
 def fill_hidden(solution: Solution, revealed: Revealed, light: HiddenLight, rep: Report, callbacks: RunCallbacks,
-                show: Callable[[np.ndarray], None] | None = None) -> tuple[np.ndarray, np.ndarray | None]:
+                show: Callable[[np.ndarray], None] | None = None) -> tuple[np.ndarray, FilledReflectance]:
     """(K, 3) radiance change of the revealed pixels: synthesised reflectance lit by the
-    irradiance after removal (`light`); and `filled_reflectance`'s lift of the object's shadow.
+    irradiance after removal (`light`); and the `filled_reflectance` it was made from.
 
     `show(change)` gets the revealed pixels' change as the fill refines: first with each
     patch's mean reflectance, then after every synthesis level of every surface and with each
     surface's final fill."""
     shown = None if show is None else (lambda rho: show(light.change(rho, revealed.radiance)))
-    rho, lift = filled_reflectance(solution, revealed, rep, callbacks, show=shown)
-    return light.change(rho, revealed.radiance), lift
+    filled = filled_reflectance(solution, revealed, rep, callbacks, show=shown)
+    return light.change(filled.rho, revealed.radiance), filled
 
 
 def filled_reflectance(solution: Solution, revealed: Revealed, rep: Report, callbacks: RunCallbacks, *,
-                       show: Callable[[np.ndarray], None] | None = None) -> tuple[np.ndarray, np.ndarray | None]:
-    """(K, 3) the reflectance of the revealed pixels, synthesised surface by surface (each
-    patch's mean reflectance where a surface is too little seen); and over the pixels of
-    `revealed.panorama`, the factor (h, w, 3) that lifts the object's shadow the relighting left
-    darker than its surface beside the hole (`shadow_lift`; None where there is none). It needs
-    no light, so a full-resolution removal computes the light after the removal meanwhile.
-    `show(rho)` gets it as `fill_hidden`'s `show` says."""
+                       show: Callable[[np.ndarray], None] | None = None) -> FilledReflectance:
+    """The reflectance of the revealed pixels, synthesised surface by surface (each patch's mean
+    reflectance where a surface is too little seen). It needs no light, so a full-resolution
+    removal computes the light after the removal meanwhile. `show(rho)` gets it as
+    `fill_hidden`'s `show` says."""
     geo = solution.geo
     patch, _, _ = solution.room.patches.lattice.locate(revealed.tri, revealed.bary)
     rho = solution.room.rho[patch].copy()
@@ -128,12 +141,15 @@ def filled_reflectance(solution: Solution, revealed: Revealed, rep: Report, call
     # taken in order afterwards. The hotel photograph's three took 1.65 s, now 1.13 s.
     fills = each(fill, planes) if show is None else map(fill, planes)  # with a preview, each shown as it comes
     surfaces, lift = [], None
+    continued = np.zeros(len(rho), dtype=bool)
     for (sel, _), (got, seconds) in zip(planes, fills, strict=True):
         name = geo.object_names[geo.tri_object[revealed.tri[sel[0]]]]
         if got.known_cells:
             rho[sel] = got.rho
             if show is not None:  # with the photograph's fine detail, which the levels do not show
                 show(rho)
+        continued[sel] = got.material.source == "wall columns" or (
+            got.hole_cells > 0 and got.structured >= 0.5 * got.hole_cells)
         if not got.synthesised:
             rep.warn(f"too little of '{name}' is seen around the object to synthesise its texture: "
                      f"{len(sel)} pixels get its mean reflectance")
@@ -156,7 +172,7 @@ def filled_reflectance(solution: Solution, revealed: Revealed, rep: Report, call
         names = {int(k): geo.object_names[geo.tri_object[t]] for k, t in zip(*np.unique(solution.target.surface_key,
                                                                                        return_index=True), strict=True)}
         rep.info["surface_edges"] = [edge.describe(names) for edge in revealed.edges.edges]
-    return rho, lift
+    return FilledReflectance(rho=rho, lift=lift, continued=continued)
 
 
 def lifted(radiance: np.ndarray, change: np.ndarray, lift: np.ndarray | None) -> np.ndarray:

@@ -27,6 +27,7 @@ from ..synthesis.plane_fill import PanoramaMaps, PanoramaReflectance
 from ..synthesis.surface_edges import SurfaceEdges
 from .compose import ratio_change, reference_irradiance
 from .fill import (
+    FilledReflectance,
     HiddenLight,
     Revealed,
     filled_reflectance,
@@ -131,7 +132,7 @@ def full_resolution(solution: Solution, hdri: np.ndarray, rep: Report, callbacks
             found = _revealed(solution, window, window_e, radiance, surfaces, revealed,
                               relit=relit_ratio(radiance, difference[rows, cols]))
 
-    def synthesis() -> tuple[np.ndarray, np.ndarray | None] | None:
+    def synthesis() -> FilledReflectance | None:
         """The revealed pixels' reflectance and the lift of the object's shadow beside them
         (`filled_reflectance`), None where there are none."""
         if found is None:
@@ -158,12 +159,13 @@ def full_resolution(solution: Solution, hdri: np.ndarray, rep: Report, callbacks
         rep.skip("synthesis", "nothing is behind the object to fill")
     else:
         with rep.stage("synthesis"):
-            rho, lift = filled
-            difference[rows[revealed], cols[revealed]] = after.change(rho, found.radiance)
-            change = lifted(radiance, difference[rows, cols], lift)
+            difference[rows[revealed], cols[revealed]] = after.change(filled.rho, found.radiance)
+            change = lifted(radiance, difference[rows, cols], filled.lift)
             surface = found.panorama.maps.surface_without.copy()  # the surfaces as the fill took them
             surface[revealed] = solution.target.surface_key[found.tri]
-            difference[rows, cols] = seamless_block_change(radiance, change, revealed, surface)
+            continued = np.zeros_like(revealed)
+            continued[revealed] = filled.continued
+            difference[rows, cols] = seamless_block_change(radiance, change, revealed, surface, continued=continued)
     unseen = int(window.hidden.sum() - revealed.sum())
     if unseen:
         rep.warn(f"{unseen} pixels of the object see no proxy geometry behind it; they are left unchanged")

@@ -149,9 +149,9 @@ def finish(solution: Solution, rep: Report, callbacks: RunCallbacks = NO_CALLBAC
             light = hidden_light(solution, found, callbacks)
         with rep.stage("synthesis"):
             # the seam is the fill's last step: it stays within the stages a removal reports
-            change, lift = fill_hidden(solution, found, light, rep, callbacks, show)
-            difference = lifted(np.asarray(solution.hdri, np.float32), difference_image(change), lift)
-            difference = _seamless(solution, filled_surfaces(solution, found), difference)
+            change, filled = fill_hidden(solution, found, light, rep, callbacks, show)
+            difference = lifted(np.asarray(solution.hdri, np.float32), difference_image(change), filled.lift)
+            difference = _seamless(solution, filled_surfaces(solution, found), difference, filled.continued)
     else:
         difference = difference_image(np.zeros((0, 3)))
         rep.skip("synthesis", "the object is not visible from the probe centre: no hidden region to fill"
@@ -217,14 +217,19 @@ def _quiet_working(solution: Solution, d_h: np.ndarray, rep: Report) -> np.ndarr
     return quiet.change.reshape(-1, 3)[traced.hp]
 
 
-def _seamless(solution: Solution, surface: np.ndarray, difference: np.ndarray) -> np.ndarray:
+def _seamless(solution: Solution, surface: np.ndarray, difference: np.ndarray, continued: np.ndarray
+              ) -> np.ndarray:
     """The working panorama's `difference` (H, W, 3) with the filled pixels' step against the
-    relit photograph around them taken out (`seam`), per `surface` (H, W) as the fill took them."""
+    relit photograph around them taken out (`seam`), per `surface` (H, W) as the fill took them;
+    `continued` (K,): the revealed pixels that continue the photograph's structure from copies."""
     traced = solution.traced
     shape = (traced.height, traced.width)
     filled = np.zeros(traced.height * traced.width, dtype=bool)
     filled[traced.hp[traced.behind.revealed]] = True
-    return seamless_panorama_change(np.asarray(solution.hdri, np.float32), difference, filled.reshape(shape), surface)
+    copies = np.zeros(traced.height * traced.width, dtype=bool)
+    copies[traced.hp[traced.behind.revealed]] = continued
+    return seamless_panorama_change(np.asarray(solution.hdri, np.float32), difference, filled.reshape(shape), surface,
+                                    continued=copies.reshape(shape))
 
 
 def _hit_image(traced: Traced, rows: np.ndarray) -> np.ndarray:

@@ -8,9 +8,10 @@ from addon.removal.seam import seamless_change
 _H, _W = 80, 120
 
 
-def _scene(step: float, seed: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def _scene(step: float, seed: int = 0, *, ramp: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """A textured floor relit by +5 %, a square filled with texture `step` brighter than it
-    should be; the surface is 0 below row 40, 1 above (a wall 3 times brighter)."""
+    should be, and from `ramp` darker at its left edge to `ramp` brighter at its right; the
+    surface is 0 below row 40, 1 above (a wall 3 times brighter)."""
     rng = np.random.default_rng(seed)
     surface = np.where(np.arange(_H)[:, None] >= 40, 0, 1) * np.ones((_H, _W), np.int64)
     base = np.where(surface == 0, 0.3, 0.9)[..., None] * np.array([1.0, 0.9, 0.8])
@@ -18,18 +19,21 @@ def _scene(step: float, seed: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarr
     filled = np.zeros((_H, _W), bool)
     filled[25:60, 40:80] = True
     truth = radiance * 1.05
-    fill = base * (1 + step) * 1.05 * (1 + 0.1 * rng.standard_normal((_H, _W, 1)))
+    across = np.clip((np.arange(_W) - 59.5) / 20, -1, 1)[None, :, None]
+    fill = base * (1 + step + ramp * across) * 1.05 * (1 + 0.1 * rng.standard_normal((_H, _W, 1)))
     edited = np.where(filled[..., None], fill, truth)
     return radiance, (edited - radiance).astype(np.float32), filled, surface
 
 
-def _step(edited: np.ndarray, filled: np.ndarray, surface: np.ndarray, s: int) -> float:
+def _step(edited: np.ndarray, filled: np.ndarray, surface: np.ndarray, s: int, *,
+          edges: tuple[str, ...] = ("left", "right")) -> float:
     """Relative step of the mean over 3 pixels inside against 3 outside, on the filled rows of
-    surface `s`, at the fill's left and right edges."""
+    surface `s`, at the fill's `edges` together."""
     rows = np.flatnonzero((surface[:, 0] == s) & filled[:, 60])
     band = edited[rows]
-    inside = band[:, 40:43].mean() + band[:, 77:80].mean()
-    outside = band[:, 37:40].mean() + band[:, 80:83].mean()
+    columns = {"left": (slice(40, 43), slice(37, 40)), "right": (slice(77, 80), slice(80, 83))}
+    inside = sum(band[:, columns[e][0]].mean() for e in edges)
+    outside = sum(band[:, columns[e][1]].mean() for e in edges)
     return abs(inside / outside - 1)
 
 
@@ -59,3 +63,20 @@ def test_no_radiance_goes_negative() -> None:
     change[filled] -= 1.0
     got = seamless_change(radiance, change, filled, surface)
     assert (radiance + got >= -1e-6).all()
+
+
+def test_a_step_that_changes_along_the_border_is_followed_where_the_fill_was_synthesised() -> None:
+    # too dark by 25 % at the left edge, too bright by as much at the right: averaged along the
+    # whole border the two would cancel and nothing be taken out
+    radiance, change, filled, surface = _scene(0.0, seed=3, ramp=0.25)
+    before = radiance + change
+    synthesised = radiance + seamless_change(radiance, change, filled, surface)
+    continued = radiance + seamless_change(radiance, change, filled, surface, continued=filled)
+    for edge in ("left", "right"):
+        step = _step(before, filled, surface, 0, edges=(edge,))
+        assert step > 0.2
+        assert _step(synthesised, filled, surface, 0, edges=(edge,)) < 0.35 * step
+        # a fill continuing the photograph's structure averages its step over twice as much of the
+        # border, where a tiling's bands differ by the same step all along a straight edge
+        assert _step(continued, filled, surface, 0, edges=(edge,)) > _step(synthesised, filled, surface, 0,
+                                                                           edges=(edge,))
