@@ -45,6 +45,8 @@ _LINE_SHARPENING = 2.0
 # detail ratios 0.78-0.85, 0.81-0.91 and 0.84-0.96; sharpened too (gain 1, weight 0) 0.67-0.73.
 _PROFILED_DETAIL = 0.45
 _PROFILE_PIXELS = 400_000  # seen pixels gathered for the planks' profile at most
+# cells: the mean a pixel's own detail is taken against (1 or 3: within 0.02 in structure)
+_PROFILE_MEAN_RADIUS = 2
 # The photograph's detail a shift map's copy adds is the surface's grain. But a shift copies a
 # whole stretch of floor, whatever lies in it, where the per-pixel synthesis picks each source
 # by how its neighbourhood fits: a thin thing lying across a shifted copy's source (a desk
@@ -56,8 +58,6 @@ _PROFILE_PIXELS = 400_000  # seen pixels gathered for the planks' profile at mos
 # Bounding the synthesis's copies too cost the plank floors without structure their seams
 # (walnut_crate's detail ratio 0.90 -> 0.81 at 1024x512) and hotel_walls' door edges.
 _GRAIN_SPREAD = 6.0
-# cells: the mean a pixel's own detail is taken against (1 or 3: within 0.02 in structure)
-_PROFILE_MEAN_RADIUS = 2
 
 
 @dataclass(frozen=True)
@@ -369,7 +369,8 @@ def _with_photograph_detail(rho: np.ndarray, panorama: PanoramaReflectance, plan
     lookup keeps a single pixel's grain (`planeraster.sample_points_keeping_grain`): a plain
     bilinear lookup kept 0.64-0.81 of the truth's pixel detail at 1024x512 on composed floors,
     this one 0.87-1.03, for 0.00-0.02 of structure (the copy's grain is its own, not the
-    truth's). Sharper lookups that move or blur the copy did worse."""
+    truth's). Sharper lookups that move or blur the copy did worse. A shifted copy's detail is
+    held within the grain's spread (`_grain_bound`)."""
     maps = panorama.maps
     r, c = _nearest_cells(raster, plane.points)
     sel = np.flatnonzero(field.copied[r, c])
@@ -382,18 +383,19 @@ def _with_photograph_detail(rho: np.ndarray, panorama: PanoramaReflectance, plan
     coarse = planeraster.sample_raster(raster, field.coarse, source)
     ok = weight > 0.5
     detail = copy[ok] - coarse[ok]
-    weight = field.detail[r[sel], c[sel]][ok]
+    gain = field.detail[r[sel], c[sel]][ok]
     composed = field.composed[r[sel], c[sel]][ok]
     if composed.any():
-        weight[composed] *= _grain_bound(detail[composed], coarse[ok][composed])
+        gain[composed] *= _grain_bound(detail[composed], coarse[ok][composed])
     out = rho.copy()
-    out[sel[ok]] += weight[:, None] * detail
+    out[sel[ok]] += gain[:, None] * detail
     return out
 
 
 def _grain_bound(detail: np.ndarray, coarse: np.ndarray) -> np.ndarray:
-    """(N,) the factor, at most 1, that brings each copy's `detail` (N, 3) within `_GRAIN_SPREAD`
-    times the median absolute deviation of all of them, in luminance relative to `coarse` (N, 3)."""
+    """(N,) the factor, at most 1, that scales each copy's `detail` (N, 3) down where its luminance
+    relative to `coarse` (N, 3) lies farther from the median of all of theirs than `_GRAIN_SPREAD`
+    times their robust spread (the median absolute deviation, scaled to a standard deviation)."""
     relative = (detail @ LUMA) / np.maximum(coarse @ LUMA, 1e-9)
     deviation = np.abs(relative - np.median(relative))
     bound = _GRAIN_SPREAD * 1.4826 * float(np.median(deviation))
