@@ -88,6 +88,9 @@ class FilledReflectance:
     # (K,) bool: on a plane whose fill continues the photograph's structure from copies: mostly a
     # tiling's or planks' shifted copies, or a wall's columns
     continued: np.ndarray
+    # (K,) bool: on a plane synthesised per pixel where the structure stage found nothing that
+    # repeats (not where it was not run)
+    unrepeated: np.ndarray
 
 
 def fill_hidden(solution: Solution, revealed: Revealed, light: HiddenLight, rep: Report, callbacks: RunCallbacks,
@@ -141,7 +144,7 @@ def filled_reflectance(solution: Solution, revealed: Revealed, rep: Report, call
     # taken in order afterwards. The hotel photograph's three took 1.65 s, now 1.13 s.
     fills = each(fill, planes) if show is None else map(fill, planes)  # with a preview, each shown as it comes
     surfaces, lift = [], None
-    continued = np.zeros(len(rho), dtype=bool)
+    continued, unrepeated = np.zeros(len(rho), dtype=bool), np.zeros(len(rho), dtype=bool)
     for (sel, _), (got, seconds) in zip(planes, fills, strict=True):
         name = geo.object_names[geo.tri_object[revealed.tri[sel[0]]]]
         if got.known_cells:
@@ -150,6 +153,8 @@ def filled_reflectance(solution: Solution, revealed: Revealed, rep: Report, call
                 show(rho)
         continued[sel] = got.material.source == "wall columns" or (
             got.hole_cells > 0 and got.structured >= 0.5 * got.hole_cells)
+        unrepeated[sel] = (options.structure and got.synthesised and got.material.source != "wall columns"
+                           and got.structured == 0 and got.band_cells == 0)
         if not got.synthesised:
             rep.warn(f"too little of '{name}' is seen around the object to synthesise its texture: "
                      f"{len(sel)} pixels get its mean reflectance")
@@ -172,7 +177,7 @@ def filled_reflectance(solution: Solution, revealed: Revealed, rep: Report, call
         names = {int(k): geo.object_names[geo.tri_object[t]] for k, t in zip(*np.unique(solution.target.surface_key,
                                                                                        return_index=True), strict=True)}
         rep.info["surface_edges"] = [edge.describe(names) for edge in revealed.edges.edges]
-    return FilledReflectance(rho=rho, lift=lift, continued=continued)
+    return FilledReflectance(rho=rho, lift=lift, continued=continued, unrepeated=unrepeated)
 
 
 def lifted(radiance: np.ndarray, change: np.ndarray, lift: np.ndarray | None) -> np.ndarray:

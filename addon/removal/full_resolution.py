@@ -163,9 +163,10 @@ def full_resolution(solution: Solution, hdri: np.ndarray, rep: Report, callbacks
             change = lifted(radiance, difference[rows, cols], filled.lift)
             surface = found.panorama.maps.surface_without.copy()  # the surfaces as the fill took them
             surface[revealed] = solution.target.surface_key[found.tri]
-            continued = np.zeros_like(revealed)
-            continued[revealed] = filled.continued
-            difference[rows, cols] = seamless_block_change(radiance, change, revealed, surface, continued=continued)
+            continued, unrepeated = np.zeros_like(revealed), np.zeros_like(revealed)
+            continued[revealed], unrepeated[revealed] = filled.continued, filled.unrepeated
+            difference[rows, cols] = seamless_block_change(radiance, change, revealed, surface, continued=continued,
+                                                           unrepeated=unrepeated)
     unseen = int(window.hidden.sum() - revealed.sum())
     if unseen:
         rep.warn(f"{unseen} pixels of the object see no proxy geometry behind it; they are left unchanged")

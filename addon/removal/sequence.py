@@ -23,7 +23,15 @@ from ..scene import SceneData
 from ..segmentation.seen import SeenObject, seen_object
 from ..segmentation.user_mask import UserMask
 from .compose import compose
-from .fill import fill_hidden, filled_surfaces, hidden_light, lifted, working_measured, working_revealed
+from .fill import (
+    FilledReflectance,
+    fill_hidden,
+    filled_surfaces,
+    hidden_light,
+    lifted,
+    working_measured,
+    working_revealed,
+)
 from .first_order import first_order
 from .full_resolution import full_resolution
 from .lit_room import LitRoom
@@ -151,7 +159,7 @@ def finish(solution: Solution, rep: Report, callbacks: RunCallbacks = NO_CALLBAC
             # the seam is the fill's last step: it stays within the stages a removal reports
             change, filled = fill_hidden(solution, found, light, rep, callbacks, show)
             difference = lifted(np.asarray(solution.hdri, np.float32), difference_image(change), filled.lift)
-            difference = _seamless(solution, filled_surfaces(solution, found), difference, filled.continued)
+            difference = _seamless(solution, filled_surfaces(solution, found), difference, filled)
     else:
         difference = difference_image(np.zeros((0, 3)))
         rep.skip("synthesis", "the object is not visible from the probe centre: no hidden region to fill"
@@ -217,19 +225,23 @@ def _quiet_working(solution: Solution, d_h: np.ndarray, rep: Report) -> np.ndarr
     return quiet.change.reshape(-1, 3)[traced.hp]
 
 
-def _seamless(solution: Solution, surface: np.ndarray, difference: np.ndarray, continued: np.ndarray
+def _seamless(solution: Solution, surface: np.ndarray, difference: np.ndarray, filled: FilledReflectance
               ) -> np.ndarray:
     """The working panorama's `difference` (H, W, 3) with the filled pixels' step against the
-    relit photograph around them taken out (`seam`), per `surface` (H, W) as the fill took them;
-    `continued` (K,): the revealed pixels that continue the photograph's structure from copies."""
+    relit photograph around them taken out (`seam`), per `surface` (H, W) as the fill took them
+    and as `filled` says it was made."""
     traced = solution.traced
     shape = (traced.height, traced.width)
-    filled = np.zeros(traced.height * traced.width, dtype=bool)
-    filled[traced.hp[traced.behind.revealed]] = True
-    copies = np.zeros(traced.height * traced.width, dtype=bool)
-    copies[traced.hp[traced.behind.revealed]] = continued
-    return seamless_panorama_change(np.asarray(solution.hdri, np.float32), difference, filled.reshape(shape), surface,
-                                    continued=copies.reshape(shape))
+    at = traced.hp[traced.behind.revealed]
+
+    def image(values: np.ndarray) -> np.ndarray:
+        out = np.zeros(traced.height * traced.width, dtype=bool)
+        out[at] = values
+        return out.reshape(shape)
+
+    return seamless_panorama_change(np.asarray(solution.hdri, np.float32), difference,
+                                    image(np.ones(len(at), dtype=bool)), surface,
+                                    continued=image(filled.continued), unrepeated=image(filled.unrepeated))
 
 
 def _hit_image(traced: Traced, rows: np.ndarray) -> np.ndarray:

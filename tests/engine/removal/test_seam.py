@@ -80,3 +80,38 @@ def test_a_step_that_changes_along_the_border_is_followed_where_the_fill_was_syn
         # border, where a tiling's bands differ by the same step all along a straight edge
         assert _step(continued, filled, surface, 0, edges=(edge,)) > _step(synthesised, filled, surface, 0,
                                                                            edges=(edge,))
+
+
+def _streaked(step: float, seed: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """A floor of one surface with streaks along its columns (a gloss's reflections, 30 % from one
+    column to the next few), a fill of streaks of its own `step` brighter than the floor."""
+    rng = np.random.default_rng(seed)
+    height, width = 120, 200
+
+    def streaks() -> np.ndarray:
+        f = rng.standard_normal((1, width, 1))
+        f = (f + np.roll(f, 1, axis=1) + np.roll(f, -1, axis=1)) / 3
+        return 1 + 0.3 * f / f.std()
+
+    base = 0.3 * np.array([1.0, 0.9, 0.8])
+    radiance = base * streaks() * (1 + 0.05 * rng.standard_normal((height, width, 1)))
+    filled = np.zeros((height, width), bool)
+    filled[30:90, 40:160] = True
+    fill = base * (1 + step) * streaks() * (1 + 0.05 * rng.standard_normal((height, width, 1)))
+    edited = np.where(filled[..., None], fill, radiance)
+    return radiance, (edited - radiance).astype(np.float32), filled, np.zeros((height, width), np.int64)
+
+
+def test_a_fill_brighter_all_round_than_a_texture_that_repeats_nowhere_is_brought_down() -> None:
+    # 15 % brighter on every side, within the streaks' own steps: no boundary pixel's step stands
+    # out, their mean over the whole border does; a darker fill is left to the local steps
+    excess = {"plain": [], "unrepeated": []}
+    for seed in range(4):
+        radiance, change, filled, surface = _streaked(0.15, seed)
+        for name, mask in (("plain", None), ("unrepeated", filled)):
+            got = radiance + seamless_change(radiance, change, filled, surface, unrepeated=mask)
+            excess[name].append(got[filled].mean() / radiance[filled].mean() - 1)
+        radiance, change, filled, surface = _streaked(-0.15, seed)
+        assert np.array_equal(seamless_change(radiance, change, filled, surface, unrepeated=filled),
+                              seamless_change(radiance, change, filled, surface))
+    assert np.mean(excess["plain"]) > 0.12 and np.mean(excess["unrepeated"]) < 0.5 * np.mean(excess["plain"])

@@ -241,14 +241,15 @@ def test_planes_filled_side_by_side_give_what_they_give_one_after_the_other(stag
     assert strip == [{k: v for k, v in s.items() if k != "seconds"} for s in reported.info["filled_surfaces"]]
 
 
-@pytest.mark.parametrize(("width", "tiling"), [(64, False), (128, True)])
-def test_the_fills_that_continue_the_photographs_structure_are_marked_so_for_the_seam(width, tiling):
+@pytest.mark.parametrize(("width", "structure", "tiling"), [(64, True, False), (128, True, True), (128, False, False)])
+def test_how_each_fill_was_made_is_marked_for_the_seam(width, structure, tiling):
     # at 128x64 the tiles recur often enough around the box to be continued as a tiling, at
     # 64x32 the floor is synthesised per pixel; the room's walls are continued along their columns
+    params = dataclasses.replace(PARAMS, synth_structure=structure)
     scene = tiny_room.scene_data(width, width // 2)
-    geo, target = prepare(scene, "Box", (), PARAMS, Report())
+    geo, target = prepare(scene, "Box", (), params, Report())
     traced = trace(geo, target, width, width // 2, fill=True, rep=Report())
-    solution = solve_lighting(scene.hdri, geo, target, traced, PARAMS, Report(), NO_CALLBACKS)
+    solution = solve_lighting(scene.hdri, geo, target, traced, params, Report(), NO_CALLBACKS)
     revealed = working_revealed(solution)
     rep = Report()
     filled = fill.filled_reflectance(solution, revealed, rep, NO_CALLBACKS)
@@ -258,6 +259,8 @@ def test_the_fills_that_continue_the_photographs_structure_are_marked_so_for_the
     shows = np.array(geo.object_names)[geo.tri_object[revealed.tri]]
     assert (shows == "Floor").any() and (shows == "Room").any()
     assert np.array_equal(filled.continued, np.isin(shows, ["Floor", "Room"] if tiling else ["Room"]))
+    # where the structure stage searched the floor for repeats and found none, the fill says so
+    assert np.array_equal(filled.unrepeated, (shows == "Floor") & structure & (not tiling))
 
 
 def test_finish_adds_the_difference_to_the_panorama_and_masks_the_object(stages):
