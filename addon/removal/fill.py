@@ -85,9 +85,7 @@ class FilledReflectance:
     # shadow the relighting left darker than its surface beside the hole (`shadow_lift`); None
     # where there is none
     lift: np.ndarray | None
-    # (K,) bool: on a plane whose fill continues the photograph's structure from copies: mostly a
-    # tiling's or planks' shifted copies, or a wall's columns
-    continued: np.ndarray
+    continued: np.ndarray  # (K,) bool: on a plane whose fill is `SurfaceFill.continued`
     # (K,) bool: on a plane synthesised per pixel where the structure stage found nothing that
     # repeats (not where it was not run)
     unrepeated: np.ndarray
@@ -151,10 +149,9 @@ def filled_reflectance(solution: Solution, revealed: Revealed, rep: Report, call
             rho[sel] = got.rho
             if show is not None:  # with the photograph's fine detail, which the levels do not show
                 show(rho)
-        continued[sel] = got.material.source == "wall columns" or (
-            got.hole_cells > 0 and got.structured >= 0.5 * got.hole_cells)
-        unrepeated[sel] = (options.structure and got.synthesised and got.material.source != "wall columns"
-                           and got.structured == 0 and got.band_cells == 0)
+        continued[sel] = got.continued
+        unrepeated[sel] = (options.structure and got.synthesised and not got.continued and got.structured == 0
+                           and got.band_cells == 0)
         if not got.synthesised:
             rep.warn(f"too little of '{name}' is seen around the object to synthesise its texture: "
                      f"{len(sel)} pixels get its mean reflectance")

@@ -138,6 +138,13 @@ class SurfaceFill:
     def lifted_pixels(self) -> int:
         return 0 if self.lift is None else int((self.lift > 1).any(axis=-1).sum())
 
+    @property
+    def continued(self) -> bool:
+        """The fill continues the photograph's structure from copies: mostly a tiling's or
+        planks' shifted copies, or a wall's columns."""
+        return self.material.source == "wall columns" or (
+            self.hole_cells > 0 and self.structured >= 0.5 * self.hole_cells)
+
 
 def fill_surface(
     panorama: PanoramaReflectance,
