@@ -45,6 +45,18 @@ def dilate(mask: np.ndarray, radius: int) -> np.ndarray:
     return box_sum(mask, radius) > 0
 
 
+def max_filter(a: np.ndarray, radius: int) -> np.ndarray:
+    """The largest value of `a` ((h, w)) within the square of `radius` around each pixel, as
+    float64; past the edges nothing is counted."""
+    out = np.asarray(a, dtype=np.float64)
+    for axis in (0, 1):
+        m = np.moveaxis(out, axis, 0)
+        edge = np.full((radius, *m.shape[1:]), -np.inf)
+        windows = np.lib.stride_tricks.sliding_window_view(np.concatenate([edge, m, edge]), 2 * radius + 1, axis=0)
+        out = np.moveaxis(windows.max(axis=-1), 0, axis)
+    return out
+
+
 def erode(mask: np.ndarray, radius: int) -> np.ndarray:
     """Pixels of `mask` whose whole square of `radius` lies in it (and in the window)."""
     return box_sum(mask, radius) == (2 * radius + 1) ** 2

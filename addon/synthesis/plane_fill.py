@@ -21,7 +21,7 @@ from .crossing import fill_crossing, find_crossing
 from .lines import sharpened_across
 from .material import Material, border_material, sharp_exemplar, wall_material
 from .plank_profile import PlankProfile, fold_profile
-from .shadow_lift import shadow_gain
+from .shadow_lift import ShadowLift, alike_mean, lift_gain, shadow_lift
 from .structure import Filled, fill_structured
 from .texture import SynthesisParams
 from .wall_columns import fill_wall
@@ -191,11 +191,11 @@ def fill_surface(
     exemplar, to_fill = material.exemplar, hole | material.replaced
     lift = None
     if not wall and crossing is None:  # a wall's columns and a band's regions are continued as they are
-        gain = shadow_gain(values, known, material, hole, relit=relit)
-        if gain is not None:
+        shadow = shadow_lift(values, known, material, hole, relit=relit)
+        if shadow is not None:
             # the fill meets, and copies from, the surface as the lifted photograph shows it
-            lift = _lift(panorama, plane, raster, gain)
-            values = values * gain
+            lift = _lift(panorama, plane, raster, shadow)
+            values = values * shadow.raster_gain(values, known)
             if lift is not None:
                 panorama = replace(panorama, rho=panorama.rho * lift)
     mean = values[exemplar].mean(axis=0) if exemplar.any() else np.zeros(3)
@@ -247,15 +247,24 @@ def _seen_points(panorama: PanoramaReflectance, rows: np.ndarray, cols: np.ndarr
     return points, (row >= 0) & (row <= h - 1) & (col >= 0) & (col <= w - 1)
 
 
-def _lift(panorama: PanoramaReflectance, plane: HiddenPlane, raster: planeraster.PlaneRaster, gain: np.ndarray
+def _lift(panorama: PanoramaReflectance, plane: HiddenPlane, raster: planeraster.PlaneRaster, shadow: ShadowLift
           ) -> np.ndarray | None:
-    """(h, w, 3) over the panorama maps' pixels, the raster's `gain` (h, w, 3:
-    `shadow_lift.shadow_gain`) at the pixels that show the plane's surface, 1 elsewhere; None
-    where it lifts none of them."""
-    rows, cols = np.nonzero(panorama.shows(plane.surface))
+    """(h, w, 3) over the panorama maps' pixels, the factor that lifts the `shadow` at each
+    pixel that shows the plane's surface, by the pixel's own deficit (`shadow_lift.lift_gain`), 1
+    elsewhere; None where it lifts none of them."""
+    shows = panorama.shows(plane.surface)
+    rows, cols = np.nonzero(shows)
     points, inside = _seen_points(panorama, rows, cols, raster)
-    lift = np.ones((*panorama.valid.shape, 3), np.float32)
-    lift[rows[inside], cols[inside]] = planeraster.sample_raster(raster, gain, points[inside])
+    rows, cols, points = rows[inside], cols[inside], points[inside]
+    weight = planeraster.sample_raster(raster, shadow.weight[..., None], points)[:, 0]
+    on = weight > 0
+    if not on.any():
+        return None
+    rows, cols, points = rows[on], cols[on], points[on]
+    bound = None if shadow.bound is None else planeraster.sample_raster(raster, shadow.bound[..., None], points)[:, 0]
+    lift = np.ones((*shows.shape, 3), np.float32)
+    level = planeraster.sample_raster(raster, shadow.level, points)
+    lift[rows, cols] = lift_gain(alike_mean(panorama.rho, shows, rows, cols), level, weight[on], bound)
     return lift if (lift > 1).any() else None
 
 

@@ -14,6 +14,7 @@ from addon.segmentation.masks import (
     double,
     erode,
     halve,
+    max_filter,
     outline,
 )
 
@@ -46,6 +47,14 @@ def test_box_mean_averages_only_the_weighted_pixels():
     assert np.allclose(mean[:, 2:], 7.0)
     assert np.all(mean[:, :2] == 0.0) and np.all(total[:, :2] == 0.0)
     assert total[2, 4] == 6.0
+
+
+def test_max_filter_matches_the_direct_maximum_over_the_square_within_the_window():
+    a = np.random.default_rng(2).random((11, 14)) - 0.5
+    for r in (0, 1, 3):
+        padded = np.pad(a, r, constant_values=-np.inf)
+        direct = np.max([padded[dy:dy + 11, dx:dx + 14] for dy in range(2 * r + 1) for dx in range(2 * r + 1)], axis=0)
+        assert np.array_equal(max_filter(a, r), direct)
 
 
 def test_dilate_and_erode_are_chebyshev_and_the_edge_is_outside():
