@@ -193,8 +193,8 @@ def _material_warning(surface: str, material: Material) -> str:
     if material.source == "whole surface":
         return (f"nothing of '{surface}' seen around the object matches the material at its border: "
                 f"the fill draws on the whole surface, clutter included")
-    return (f"'{surface}' around the object is mostly another material than at its border (clutter, a rug): "
-            f"the fill draws only on the {material.share:.0%} that matches")
+    return (f"'{surface}' around the object is mostly unlike the material at its border (clutter, a rug, or the "
+            f"same floor in another light or sheen): the fill draws only on the {material.share:.0%} that matches")
 
 
 def hidden_planes(geo: Geometry, keys: np.ndarray, tri: np.ndarray, points: np.ndarray
