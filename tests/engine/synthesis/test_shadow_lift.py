@@ -7,15 +7,15 @@ import numpy as np
 
 from addon.light.radiosity import LUMA
 from addon.segmentation.masks import dilate
-from addon.synthesis.material import border_material, wall_material
+from addon.synthesis.material import Material, border_material, wall_material
 from addon.synthesis.shadow_lift import shadow_lift
 from tests.engine.synthesis.test_material import _hole, _shade
 
 _H, _W = 120, 160
 
 
-def shadow_gain(image: np.ndarray, known: np.ndarray, material, hole: np.ndarray, *,
-                relit: np.ndarray | None = None) -> np.ndarray | None:
+def _gain(image: np.ndarray, known: np.ndarray, material: Material, hole: np.ndarray, *,
+          relit: np.ndarray | None = None) -> np.ndarray | None:
     """The raster's gain (h, w, 3) that lifts the material's shadow, None where there is none."""
     lift = shadow_lift(image, known, material, hole, relit=relit)
     return None if lift is None else lift.raster_gain(image, known)
@@ -34,7 +34,7 @@ def test_the_shadow_left_beside_the_hole_is_brought_to_the_floors_level_its_grai
     image = floor * shade[..., None]
     material = border_material(image, ~hole, hole, min_cells=64)
     assert material.shadow is not None and material.shadow.any()
-    gain = shadow_gain(image, ~hole, material, hole)
+    gain = _gain(image, ~hole, material, hole)
     lifted = (image * gain) @ LUMA
     level = np.median((floor @ LUMA)[~hole])
     # (the test's shadow ends sideways in a hard edge, which a 5x5 level blurs: its inside)
@@ -51,9 +51,9 @@ def test_the_shadow_left_beside_the_hole_is_brought_to_the_floors_level_its_grai
 def test_a_floor_without_the_objects_shadow_is_not_lifted() -> None:
     hole = _hole()
     image = _floor(4)
-    assert shadow_gain(image, ~hole, border_material(image, ~hole, hole, min_cells=64), hole) is None
+    assert _gain(image, ~hole, border_material(image, ~hole, hole, min_cells=64), hole) is None
     # nor is a wall, whose material has no shadow
-    assert shadow_gain(image, ~hole, wall_material(~hole), hole) is None
+    assert _gain(image, ~hole, wall_material(~hole), hole) is None
 
 
 def test_a_few_dark_cells_beside_the_hole_are_the_floors_own_not_lifted() -> None:
@@ -61,11 +61,11 @@ def test_a_few_dark_cells_beside_the_hole_are_the_floors_own_not_lifted() -> Non
     shade = _shade(0.4)
     image = _floor(6) * shade[..., None]
     material = border_material(image, ~hole, hole, min_cells=64)
-    assert shadow_gain(image, ~hole, material, hole) is not None
+    assert _gain(image, ~hole, material, hole) is not None
     few = np.zeros_like(hole)
     few[74:76, 74:77] = material.shadow[74:76, 74:77]  # six cells along a border of about a hundred
     assert few.any()
-    assert shadow_gain(image, ~hole, replace(material, shadow=few), hole) is None
+    assert _gain(image, ~hole, replace(material, shadow=few), hole) is None
 
 
 def _bounced(shade: np.ndarray, floor: np.ndarray) -> np.ndarray:
@@ -87,7 +87,7 @@ def test_a_shadow_in_the_floors_bounced_colour_is_lifted_to_the_floors_colour() 
     image = _bounced(shade, floor)
     material = border_material(image, ~hole, hole, min_cells=64)
     assert material.shadow is not None and material.shadow.sum() > 200
-    gain = shadow_gain(image, ~hole, material, hole)
+    gain = _gain(image, ~hole, material, hole)
     assert gain is not None
     deep = (shade < 0.6) & ~hole & dilate(hole, 6) & (np.abs(np.arange(_W) - 75) <= 14)[None, :]
     chroma = lambda x: x / x.sum(axis=-1, keepdims=True)  # noqa: E731
@@ -107,11 +107,11 @@ def test_a_darkening_the_relighting_does_not_brighten_is_not_lifted() -> None:
     unchanged = np.ones((_H, _W))
     material = border_material(image, ~hole, hole, min_cells=64, relit=unchanged)
     assert material.shadow is None or not material.shadow.any()
-    assert shadow_gain(image, ~hole, material, hole) is None
+    assert _gain(image, ~hole, material, hole) is None
     # relit only within 4 rows of the hole: the shadow stops there, and its penumbra with it
     relit = np.where(np.indices((_H, _W))[0] < 78, 1.5, 1.0)
     material = border_material(image, ~hole, hole, min_cells=64, relit=relit)
-    gain = shadow_gain(image, ~hole, material, hole)
+    gain = _gain(image, ~hole, material, hole)
     assert gain is not None and (gain[74:78] > 1).any()
     # (a cell past it carries its weight, for the pixels looked up between: `test_a_shadows_sharp_edge...`)
     assert np.all(gain[79:] == 1.0)
@@ -126,7 +126,7 @@ def test_the_shadow_is_lifted_to_the_floor_beside_it_not_to_the_floors_median() 
     floor = _floor(9) * np.where(rows < 62, 1.4, 1.0)[..., None]  # the far side, above, paler
     image = floor * shade[..., None]
     material = border_material(image, ~hole, hole, min_cells=64)
-    gain = shadow_gain(image, ~hole, material, hole)
+    gain = _gain(image, ~hole, material, hole)
     assert gain is not None
     deep = (shade < 0.5) & ~hole & dilate(hole, 6) & (np.abs(np.arange(_W) - 75) <= 14)[None, :]
     near = np.median((floor @ LUMA)[(rows > 90) & ~hole])
@@ -146,7 +146,7 @@ def test_a_shadow_far_deeper_than_the_relighting_made_it_is_lifted_no_more_than_
     for change in (1.1, 2.5):
         relit = np.full((_H, _W), change)
         material = border_material(image, ~hole, hole, min_cells=64, relit=relit)
-        gain = shadow_gain(image, ~hole, material, hole, relit=relit)
+        gain = _gain(image, ~hole, material, hole, relit=relit)
         assert gain is not None
         lifts[change] = np.median((gain @ LUMA)[deep])
     assert lifts[1.1] <= 1.1**2 + 1e-6
@@ -178,8 +178,8 @@ def test_a_shadows_sharp_edge_is_lifted_to_its_last_cell_and_the_floor_beside_it
 
 def test_a_proxys_shadow_a_cell_or_two_short_of_the_objects_bounds_the_lift_as_if_it_reached() -> None:
     """A proxy modelled a few centimetres off casts its shadow as far off: where the relighting's
-    change falls to 1 two rows before the photographed shadow ends, those rows are still
-    lifted as much as the rows it covers."""
+    change falls to 1 two rows before the photographed shadow ends, the bound on those rows'
+    lift is the one on the rows it covers."""
     hole = _hole()
     shade = np.where((np.indices((_H, _W))[0] >= 74) & (np.abs(np.arange(_W) - 75) <= 18)[None, :]
                      & (np.indices((_H, _W))[0] < 82), 0.5, 1.0)
