@@ -212,15 +212,16 @@ def test_a_fine_print_as_dark_beside_the_hole_is_no_shadow() -> None:
             assert halo[(shade < 0.7) & dilate(hole, 8)].mean() > 0.9
 
 
-def test_a_shadow_takes_the_colours_between_its_surfaces_and_its_surfaces_bounced() -> None:
+def test_a_shadow_takes_the_colours_along_its_surfaces_and_its_surfaces_bounced() -> None:
     """The light left in a shadow is the surface's own, bounced: a warm floor's shadow is more
-    saturated than the floor, up to the floor's colour squared; it is not bluer, nor another hue."""
+    saturated than the floor, up to the floor's colour squared; or, where the object holds back
+    a warm light and leaves a cooler one, less saturated by as much. It is not another hue."""
     rgb = np.array([0.45, 0.30, 0.18])
     chroma = lambda x: (x / x.sum())[:2]  # noqa: E731
     floor = chroma(rgb)
     cells = np.array([[floor, chroma(rgb**1.5), chroma(rgb**2), chroma(rgb**0.5), chroma(rgb[::-1]),
-                       chroma(np.array([0.30, 0.45, 0.18]))]])
-    assert _shadow_colours(cells, floor).tolist() == [[True, True, True, False, False, False]]
+                       chroma(np.array([0.30, 0.45, 0.18])), chroma(rgb**3.5)]])
+    assert _shadow_colours(cells, floor).tolist() == [[True, True, True, True, False, False, False]]
 
 
 def _footprint() -> np.ndarray:
