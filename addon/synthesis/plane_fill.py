@@ -21,7 +21,7 @@ from .crossing import fill_crossing, find_crossing
 from .lines import sharpened_across
 from .material import Material, border_material, sharp_exemplar, wall_material
 from .plank_profile import PlankProfile, fold_profile
-from .shadow_lift import ShadowLift, alike_mean, lift_gain, shadow_lift
+from .shadow_lift import ShadowLift, lift_gain, shadow_lift
 from .structure import Filled, fill_structured
 from .texture import SynthesisParams
 from .wall_columns import fill_wall
@@ -264,7 +264,7 @@ def _lift(panorama: PanoramaReflectance, plane: HiddenPlane, raster: planeraster
     bound = None if shadow.bound is None else planeraster.sample_raster(raster, shadow.bound[..., None], points)[:, 0]
     lift = np.ones((*shows.shape, 3), np.float32)
     level = planeraster.sample_raster(raster, shadow.level, points)
-    lift[rows, cols] = lift_gain(alike_mean(panorama.rho, shows, rows, cols), level, weight[on], bound)
+    lift[rows, cols] = lift_gain(panorama.rho, shows, rows, cols, level=level, weight=weight[on], bound=bound)
     return lift if (lift > 1).any() else None
 
 

@@ -75,36 +75,39 @@ class ShadowLift:
         rows, cols = np.nonzero(known & (self.weight > 0))
         out = np.ones(values.shape)
         bound = None if self.bound is None else self.bound[rows, cols]
-        out[rows, cols] = lift_gain(alike_mean(values, known, rows, cols), self.level[rows, cols],
-                                    self.weight[rows, cols], bound)
+        out[rows, cols] = lift_gain(values, known, rows, cols, level=self.level[rows, cols],
+                                    weight=self.weight[rows, cols], bound=bound)
         return out
 
 
-def lift_gain(local: np.ndarray, level: np.ndarray, weight: np.ndarray, bound: np.ndarray | None) -> np.ndarray:
-    """(N, 3) the factor per channel, 1 or more, that brings `local` (N, 3: a cell's or pixel's
-    own level, `alike_mean`) `weight` (N,) of the way to `level` (N, 3), in luminance at most
-    `bound` (N,; None: `_MAX_LIFT`)."""
-    deficit = np.clip(level / np.maximum(local, 1e-9), 1.0, _MAX_LIFT)
+def lift_gain(image: np.ndarray, valid: np.ndarray, rows: np.ndarray, cols: np.ndarray, *, level: np.ndarray,
+              weight: np.ndarray, bound: np.ndarray | None) -> np.ndarray:
+    """(N, 3) the factor per channel, 1 or more, that brings the pixels (`rows`, `cols`) of
+    `image` (h, w, 3; `valid` (h, w) where it is measured), each by its own level
+    (`_alike_mean`), `weight` (N,) of the way to `level` (N, 3), in luminance at most `bound`
+    (N,; None: `_MAX_LIFT`)."""
+    deficit = np.clip(level / np.maximum(_alike_mean(image, valid, rows, cols), 1e-9), 1.0, _MAX_LIFT)
     if bound is not None:
         luminance = np.maximum(deficit @ LUMA, 1.0)
         deficit = np.maximum(deficit * np.minimum(bound / luminance, 1.0)[:, None], 1.0)
     return 1 + (deficit - 1) * weight[:, None]
 
 
-def alike_mean(image: np.ndarray, valid: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+def _alike_mean(image: np.ndarray, valid: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
     """(N, 3) at the pixels (`rows`, `cols`) of `image` (h, w, 3), the mean of the `valid`
     pixels among their 3x3 neighbours whose luminance lies within `_ALIKE` of theirs: a
-    pixel's own level, its grain averaged, not the other side of an edge beside it."""
+    pixel's own level, its grain averaged, not the other side of an edge beside it. Only those
+    pixels are read: at full resolution the image is the object's whole window."""
     h, w = valid.shape
-    luminance = np.maximum(image @ LUMA, 1e-12)
-    own = luminance[rows, cols]
+    own = np.maximum(image[rows, cols] @ LUMA, 1e-12)
     total, count = np.zeros((len(rows), 3)), np.zeros(len(rows))
     for dr in (-1, 0, 1):
         for dc in (-1, 0, 1):
             r, c = np.clip(rows + dr, 0, h - 1), np.clip(cols + dc, 0, w - 1)
-            ratio = luminance[r, c] / own
+            neighbour = image[r, c]
+            ratio = np.maximum(neighbour @ LUMA, 1e-12) / own
             take = valid[r, c] & (ratio < _ALIKE) & (ratio > 1 / _ALIKE) & (r == rows + dr) & (c == cols + dc)
-            total += np.where(take[:, None], image[r, c], 0.0)
+            total += np.where(take[:, None], neighbour, 0.0)
             count += take
     return np.where(count[:, None] > 0, total / np.maximum(count, 1)[:, None], image[rows, cols])
 
