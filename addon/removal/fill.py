@@ -158,7 +158,7 @@ def filled_reflectance(solution: Solution, revealed: Revealed, rep: Report, call
         if got.synthesised and got.material.mostly_other:
             rep.warn(_material_warning(name, got.material))
         if got.band_cells:
-            rep.warn(f"a band crossing the object on '{name}' (a painted lane, a strip between two floors) is "
+            rep.warn(f"a band crossing the object on '{name}' (a painted lane, a rug, a strip between two floors) is "
                      f"continued through it as a straight strip: where it bends or ends under the object, turn "
                      f"Structure (synth_structure) off")
         surfaces.append({"surface": name, "pixels": len(sel), "raster": list(got.raster_shape),

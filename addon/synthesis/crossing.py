@@ -9,8 +9,14 @@ of their width, and the hole's pieces on either side take their own side's mater
 and the strip are synthesised from the cells of their own colour around the hole and brought to
 the level of that colour at their border (`fill_crossing`).
 
-A stripe with the same material on both sides (a chair's two legs, a line across one floor) is
-left to the material's fill: nothing tells whether it crosses or ends under the object.
+The colours are read with their texture, the contrast of luminance around each cell: a rug's black
+and white stripes average to the wood's colour, but not to its texture. With the same material on
+both sides (or no one material on a side), a band is continued only where it lines up across the
+hole: its two places at the border equally placed across the line joining them, and seen running
+on straight away from the hole past one of them. A band much darker than that material is not:
+two feet or legs of one thing, in line on two sides, end under the object as often as they cross.
+A stripe that does not line up is left to the material's fill: nothing tells whether it crosses
+or ends under the object.
 """
 from __future__ import annotations
 
@@ -21,13 +27,15 @@ import numpy as np
 from ..errors import DimredError
 from ..light.radiosity import LUMA
 from ..segmentation.masks import box_mean, components, dilate
-from .material import colour_features, direction_bins, log_luminance, ring_widths
+from .material import colour_features, direction_bins, log_luminance, log_spread, ring_widths
 from .structure import Filled
 from .texture import CancelFn, SynthesisParams, fill_with_sources, membrane
 
-# Colour features: log luminance over 0.3, chromaticity (r, g) over 0.03. Light printed on a
-# photographed floor changes its luminance across the hole far more than its chromaticity.
-_SCALE = np.array([0.3, 0.03, 0.03])
+# Colour features: log luminance over 0.3, chromaticity (r, g) over 0.03, and the spread of log
+# luminance over 0.1 (all over 5x5 cells). Light printed on a photographed floor changes its
+# luminance across the hole far more than its chromaticity. The spread tells a rug's stripes from
+# the wood they average to (photo-textured hotel_rug_box at 512x256: 0.3-0.5 against 0.02-0.05).
+_SCALE = np.array([0.3, 0.03, 0.03, 0.1])
 _CLUSTERS = 6  # colours looked for around the hole before near ones are merged
 _MERGE = 3.0  # feature distance below which two colours are one
 _BINS = 72  # directions the border is read in
@@ -40,6 +48,12 @@ _SIDE_SHARE = 0.7  # share of a side's directions its material must hold
 _SEEN_SHARE = 0.9
 _LEVEL_RADIUS = 2  # cells: the mean a region's own colour is taken over around the hole
 _GRAIN_RADIUS = 3  # cells: the synthesis's grain is its luminance over its mean over this square
+# A band with one material on both sides: the share of the two places' extents across the line
+# joining them that both hold, and the share of the cells past one place, within the ring's reach
+# and its extent, that must be of the band (at least half of them seen).
+_OVERLAP = 0.5
+_RUNS_ON = 0.6
+_FEET = 4.0  # times darker than the material on both its sides: no band, but feet or legs
 
 
 @dataclass(frozen=True)
@@ -74,18 +88,21 @@ def find_crossing(image: np.ndarray, known: np.ndarray, hole: np.ndarray) -> Cro
     directions = direction_bins(*np.indices(hole.shape), centre, _BINS)
     if (_border_sequence(annulus.astype(np.int64) - 1, annulus, directions) >= 0).mean() < _SEEN_SHARE:
         return None  # decided before the colours are: most holes on a floor's edge end here
-    features = colour_features(image, log_luminance(image), known, radius=2) / _SCALE
-    labels = np.full(hole.shape, -1)
-    labels[near] = _colour_labels(features[ring], features[near])
-    around = _border_sequence(labels, annulus, directions)
-    found = _band(around)
-    if found is None:
+    log_y = log_luminance(image)
+    colour = colour_features(image, log_y, known, radius=2)
+    textured = np.concatenate([colour, log_spread(log_y, known, colour[..., 0], radius=2)[..., None]], axis=-1)
+    # Colour alone first: along every edge between two colours the spread is high too, and there
+    # it reads as a colour of its own
+    for features in (colour / _SCALE[:3], textured / _SCALE):
+        labels = np.full(hole.shape, -1)
+        labels[near] = _colour_labels(features[ring], features[near])
+        found = _lined_up_band(labels, colour[..., 0], hole, ring=ring, near=near, annulus=annulus,
+                               directions=directions, reach=reach)
+        if found is not None:
+            break
+    else:
         return None
-    band, runs = found
-    inner = ring & dilate(hole, max(reach // 2, 4)) & (labels == band)
-    ends = [_run_cells(inner, directions, start, length) for start, length in runs]
-    if min(len(e) for e in ends) < 4:
-        return None
+    band, ends = found
     regions = np.full(hole.shape, -1)
     regions[_strip(hole, *ends)] = band
     pieces, count = components(hole & (regions < 0))
@@ -97,6 +114,29 @@ def find_crossing(image: np.ndarray, known: np.ndarray, hole: np.ndarray) -> Cro
             return None  # a piece with no colour beside it: nothing to say what it continues
         regions[cells] = np.bincount(beside).argmax()
     return Crossing(regions=regions, labels=labels, band=band)
+
+
+def _lined_up_band(labels: np.ndarray, log_y: np.ndarray, hole: np.ndarray, *, ring: np.ndarray,
+                   near: np.ndarray, annulus: np.ndarray, directions: np.ndarray,
+                   reach: int) -> tuple[int, list[np.ndarray]] | None:
+    """The band among `labels` read around `hole` (`_band`) and its cells where it meets the hole
+    on each side, or None where none is found, its cells there are too few to place it, or it has
+    one material on both sides and is much darker than that (`log_y`: log luminance) or does not
+    line up across the hole (`_in_line`)."""
+    found = _band(_border_sequence(labels, annulus, directions))
+    if found is None:
+        return None
+    band, runs, apart = found
+    inner = ring & dilate(hole, max(reach // 2, 4)) & (labels == band)
+    ends = [_run_cells(inner, directions, start, length) for start, length in runs]
+    if min(len(e) for e in ends) < 4:
+        return None
+    if not apart:
+        material = np.bincount(labels[ring & (labels >= 0) & (labels != band)]).argmax()
+        level = [np.median(log_y[ring & (labels == label)]) for label in (band, material)]
+        if level[0] < level[1] - np.log(_FEET) or not _in_line(labels, near, band, *ends, reach=reach):
+            return None
+    return band, ends
 
 
 def fill_crossing(crossing: Crossing, image: np.ndarray, known: np.ndarray, params: SynthesisParams, *,
@@ -176,18 +216,21 @@ def _runs(around: np.ndarray) -> list[tuple[int, int, int]]:
     return [(int(around[s]), int(s), int((e - s) % n) or n) for s, e in zip(starts, ends, strict=True)]
 
 
-def _band(around: np.ndarray) -> tuple[int, list[tuple[int, int]]] | None:
-    """The label that meets the border in exactly two short runs separating two sides held by two
-    different materials, with its runs (first direction, length); None where none does."""
+def _band(around: np.ndarray) -> tuple[int, list[tuple[int, int]], bool] | None:
+    """The label that meets the border in exactly two short runs between two sides wider than
+    such a run, with its runs (first direction, length) and whether the sides are held by two
+    different materials (the first such label, else the first of any); None where none does."""
     runs = _runs(around)
+    found = []
     for label in sorted({r[0] for r in runs if r[0] >= 0}):
         mine = [(s, n) for lab, s, n in runs if lab == label]
         if len(mine) != 2 or max(n for _, n in mine) > _MAX_BAND:
             continue
+        if min((b[0] - a[0] - a[1]) % len(around) for a, b in ((mine[0], mine[1]), (mine[1], mine[0]))) < _MAX_BAND:
+            continue
         sides = [_side(around, a, b) for a, b in ((mine[0], mine[1]), (mine[1], mine[0]))]
-        if None not in sides and sides[0] != sides[1]:
-            return label, mine
-    return None
+        found.append((label, mine, None not in sides and sides[0] != sides[1]))
+    return max(found, key=lambda f: f[2], default=None)
 
 
 def _side(around: np.ndarray, run: tuple[int, int], next_run: tuple[int, int]) -> int | None:
@@ -207,6 +250,39 @@ def _run_cells(cells: np.ndarray, directions: np.ndarray, start: int, length: in
     return np.argwhere(cells & inside).astype(np.float64)
 
 
+def _across(cells: np.ndarray, across: np.ndarray) -> tuple[float, float]:
+    """How far `cells` (N, 2) reach along the unit vector `across` (5th and 95th percentiles)."""
+    lo, hi = np.percentile(cells @ across, [5, 95])
+    return float(lo), float(hi)
+
+
+def _in_line(labels: np.ndarray, near: np.ndarray, band: int, first: np.ndarray, second: np.ndarray, *,
+             reach: int) -> bool:
+    """Whether the `band` cells where it meets the hole on one side (`first`, (N, 2)) and on the
+    other (`second`) line up across it: their extents across the line joining them overlapping by
+    `_OVERLAP` of both together, and the band running on straight away from the hole past one of
+    them (`_RUNS_ON` of the `near` cells of `labels` within `reach` past it and within its extent)."""
+    a, b = first.mean(axis=0), second.mean(axis=0)
+    length = float(np.linalg.norm(b - a))
+    if length < 1e-9:
+        return False
+    along = (b - a) / length
+    across = np.array([-along[1], along[0]])
+    cells, seen = np.argwhere(near), labels[near]
+    extents, runs_on = [], []
+    for end, at_end, outward in ((a, first, -along), (b, second, along)):
+        lo, hi = _across(at_end, across)
+        past = (cells - end) @ outward
+        offset = cells @ across
+        corridor = (past > 0) & (past <= reach) & (offset >= lo) & (offset <= hi)
+        extents.append((lo, hi))
+        runs_on.append(corridor.sum() >= 0.5 * reach * max(hi - lo, 1.0)
+                       and (seen[corridor] == band).mean() >= _RUNS_ON)
+    (lo0, hi0), (lo1, hi1) = extents
+    overlap = (min(hi0, hi1) - max(lo0, lo1)) / max(max(hi0, hi1) - min(lo0, lo1), 1e-9)
+    return overlap >= _OVERLAP and any(runs_on)
+
+
 def _strip(hole: np.ndarray, first: np.ndarray, second: np.ndarray) -> np.ndarray:
     """(h, w) the hole cells of the straight strip joining the band's cells where it meets the
     hole on one side (`first`, (N, 2)) to the other's, its width measured across it at each end
@@ -219,7 +295,7 @@ def _strip(hole: np.ndarray, first: np.ndarray, second: np.ndarray) -> np.ndarra
     across = np.array([-along[1], along[0]])
     offsets, widths = [], []
     for cells in (first, second):
-        lo, hi = np.percentile(cells @ across, [5, 95])
+        lo, hi = _across(cells, across)
         offsets.append(0.5 * (lo + hi) - a @ across)
         widths.append(hi - lo)
     rows, cols = np.nonzero(hole)

@@ -219,6 +219,14 @@ def colour_features(image: np.ndarray, log_y: np.ndarray, known: np.ndarray, *, 
     return mean
 
 
+def log_spread(log_y: np.ndarray, known: np.ndarray, mean: np.ndarray, *, radius: int) -> np.ndarray:
+    """(h, w) the standard deviation of `log_y` (log luminance) over the `known` cells within
+    `radius`, about their `mean` (h, w: `colour_features`' first, at the same radius): how much
+    contrast a texture holds there."""
+    square, _ = box_mean((log_y**2)[..., None], known, radius)
+    return np.sqrt(np.maximum(square[..., 0] - mean**2, 0.0))
+
+
 def direction_bins(rows: np.ndarray, cols: np.ndarray, centre: tuple[float, float], count: int) -> np.ndarray:
     """The direction (0..count-1) in which each cell (rows, cols) lies seen from `centre`."""
     return ((np.arctan2(rows - centre[0], cols - centre[1]) + np.pi) / (2 * np.pi) * count).astype(np.int64) % count
@@ -271,10 +279,8 @@ def _shadow_halo(mean: np.ndarray, log_y: np.ndarray, known: np.ndarray, materia
         return np.zeros_like(hole), np.zeros_like(hole), np.zeros_like(hole)
     levels = mean[..., 0][material]
     level = min(np.median(levels) + np.log(_HALO_DARKER), np.quantile(levels, _HALO_QUANTILE) + np.log(_HALO_BELOW))
-    square, _ = box_mean((log_y**2)[..., None], known, 1)
-    deviation = np.sqrt(np.maximum(square[..., 0] - mean[..., 0] ** 2, 0.0))
     alike = known & _shadow_colours(mean[..., 1:], np.median(mean[..., 1:][material], axis=0)) & (
-        deviation < _HALO_SMOOTH)
+        log_spread(log_y, known, mean[..., 0], radius=1) < _HALO_SMOOTH)
     shade = alike & brightened & dilate(hole, reach) & (mean[..., 0] < level)
     labels, _ = components(shade | hole)
     halo = shade & np.isin(labels, np.unique(labels[hole]))

@@ -114,7 +114,7 @@ class FillOptions:
     synthesis: SynthesisParams
     seed: int = 0
     # compose tiled and planked floors from shifted copies first (`structure`), and continue a band
-    # that crosses the hole between two materials (`crossing`)
+    # that crosses the hole (`crossing`)
     structure: bool = True
 
 

@@ -56,14 +56,16 @@ FAILING: dict[tuple[str, str], str] = {
     # median 0.91 and the worst draw 0.75 (bench_photo_stability).
     ("workshop_box", "total"): "measured 0.294",
     ("workshop_box", "detail"): "measured 0.705",
-    # The rug's striped band passes under the box between the bed's olive cover and the wood.
-    # Around the hole the bed and the wood read as one colour (their chromaticities within
-    # 0.04), so no band between two materials is found (`crossing`), and the rug, seen on one
-    # side, is left out as clutter: the hole is filled with wood where the truth shows the rug's
-    # black and white stripes, too bright and too smooth.
-    ("hotel_rug_box", "total"): "measured 0.669",
-    ("hotel_rug_box", "mean_error"): "measured 0.390",
-    ("hotel_rug_box", "detail"): "measured 0.367",
+    # The rug's striped band passes under the box between the bed's olive cover and the wood,
+    # which read as one colour around the hole (their chromaticities within 0.04). Its texture
+    # tells the rug from them, but at this size it meets the hole's lower side in 4 directions
+    # and its upper side in 10, whose extents across the line joining them share 0.44: no band
+    # that lines up (`crossing`). The rug, seen on one side, is left out as clutter, and the hole
+    # is filled with wood where the truth shows its black and white stripes, too bright and too
+    # smooth. At 512x256 and 128 samples the band is continued (detail 0.68, total 0.238).
+    ("hotel_rug_box", "total"): "measured 0.697",
+    ("hotel_rug_box", "mean_error"): "measured 0.414",
+    ("hotel_rug_box", "detail"): "measured 0.364",
     # The sunlit patch printed on the floor is continued under the box by the material's fill
     # (within all the bounds at 512x256 and 128 samples: mean error 0.019, total 0.140); at this
     # size the hole is a few dozen cells and the fill a little too dark.

@@ -1,4 +1,5 @@
-"""A band crossing the hole between two materials is continued across it, each side with its own."""
+"""A band crossing the hole between two materials, or lining up across it on one, is continued
+across it, each side with its own material."""
 from __future__ import annotations
 
 import numpy as np
@@ -54,12 +55,45 @@ def test_a_lane_between_two_floors_runs_on_across_the_hole() -> None:
     assert len(src) and (across[src[:, 0], src[:, 1]] > 3.5).all()
 
 
-@pytest.mark.parametrize("case", ["same floor both sides", "checker", "plain"])
+def test_a_lane_in_line_across_one_floor_runs_on_across_the_hole() -> None:
+    truth, across = _lane(far=_GREEN)
+    hole = _hole()
+    crossing = find_crossing(np.where(hole[..., None], 0.0, truth), ~hole, hole)
+    assert crossing is not None
+    band = crossing.regions == crossing.band
+    assert band[hole & (np.abs(across) < 2.0)].all()
+    sides = crossing.regions[hole & (np.abs(across) > 6.0)]
+    assert (sides != crossing.band).all() and len(np.unique(sides)) == 1  # one floor on both sides
+
+
+def test_a_striped_band_of_the_floor_s_mean_colour_is_told_by_its_texture() -> None:
+    """A rug's black and white stripes, averaging to the floor's colour over a few cells, crossing
+    the hole between two floors that read as one colour."""
+    truth, across = _lane(far=_GREEN * 1.15, width=12.0)
+    rows, cols = np.indices((_H, _W))
+    stripes = np.where(((rows + cols) // 2 % 2 == 0)[..., None], 1.85, 0.15)
+    rug = np.abs(across) <= 6.0
+    truth[rug] = (_GREEN * stripes)[rug] * (1 + 0.3 * cols / _W)[rug, None]
+    hole = _hole()
+    crossing = find_crossing(np.where(hole[..., None], 0.0, truth), ~hole, hole)
+    assert crossing is not None
+    assert (crossing.regions == crossing.band)[hole & (np.abs(across) < 3.0)].all()
+
+
+def test_a_stripe_out_of_line_across_one_floor_is_no_band() -> None:
+    """A stripe reaching the hole from above and one from below, a few cells apart across: two
+    things that end under the object, not one that passes."""
+    image, _ = _lane(far=_GREEN, width=0.0)
+    hole = _hole()
+    image[4:44, 68:75] = _YELLOW
+    image[78:124, 86:93] = _YELLOW
+    assert find_crossing(image, ~hole, hole) is None
+
+
+@pytest.mark.parametrize("case", ["checker", "plain"])
 def test_nothing_crosses_where_nothing_tells_it_does(case: str) -> None:
     hole = _hole()
-    if case == "same floor both sides":  # a line across one floor may as well end under the object
-        image, _ = _lane(far=_GREEN)
-    elif case == "checker":
+    if case == "checker":
         rows, cols = np.indices((_H, _W))
         image = np.where((((rows // 12) + (cols // 12)) % 2 == 0)[..., None], _GREEN, _YELLOW)
     else:
@@ -67,7 +101,7 @@ def test_nothing_crosses_where_nothing_tells_it_does(case: str) -> None:
     assert find_crossing(image, ~hole, hole) is None
 
 
-def test_legs_on_two_sides_of_one_floor_are_no_band() -> None:
+def test_dark_legs_in_line_on_two_sides_of_one_floor_are_no_band() -> None:
     image, _ = _lane(far=_GREEN, width=0.0)
     hole = _hole()
     legs = np.zeros((_H, _W), bool)
