@@ -891,6 +891,74 @@ def _apartment_sun_box() -> SceneSpec:
     )
 
 
+# Placed after the engine's rules for the rug, the sun patch and the lane were made, on the same
+# photographs: the rug under a stool between the bed and the wood, its middle under a box whose
+# hidden floor reaches the raster's edge, its corner under a box; the desk's printed shadow edge;
+# a box beside the lobby's bench; a crate on the warehouse's open concrete.
+
+
+def _hotel_rug_stool() -> SceneSpec:
+    room = _hotel_room()
+    return SceneSpec(
+        name="hotel_rug_stool",
+        room=room,
+        lamps=(Lamp((0.2, 1.6), (0.4, 0.4), 35.0, (1.0, 0.9, 0.75)),),
+        objects=(SceneObject("Stool", "stool", (0.35, 0.35, 0.35), _on_floor(room, -0.2, 0.05), (0.3, 0.3, 0.32),
+                             seat="round", legs=4),),
+        probe=(0.6, 1.4, 1.5),
+        remove="Stool",
+        render=_PHOTO_RENDER,
+        windows=(Window("east", (0.5, 1.4), (1.6, 1.7), 5.0, (1.0, 0.97, 0.92)),),
+    )
+
+
+def _hotel_rug_box_far(name: str, x: float, y: float, size: float, rotation: float) -> SceneSpec:
+    room = _hotel_room()
+    return SceneSpec(
+        name=name,
+        room=room,
+        lamps=(Lamp((-0.5, 1.5), (0.3, 0.3), 30.0, (1.0, 0.9, 0.75)), Lamp((0.6, -0.6), (0.3, 0.3), 20.0)),
+        objects=(SceneObject("Box", "box", (size, size, size), _on_floor(room, x, y), (0.45, 0.5, 0.55),
+                             rotation_z=rotation),),
+        probe=(0.3, 1.2, 1.5),
+        remove="Box",
+        render=_PHOTO_RENDER,
+        windows=(Window("east", (0.5, 1.4), (1.6, 1.7), 5.0, (1.0, 0.97, 0.92)),),
+    )
+
+
+def _lobby_bench_box() -> SceneSpec:
+    room = Room(lo=(-3.0, -2.5, 0.0), hi=(3.0, 2.5, 2.8), wall_albedo=(0.75, 0.75, 0.72),
+                floor=_photo_floor("lobby.exr"))
+    return SceneSpec(
+        name="lobby_bench_box",
+        room=room,
+        lamps=(Lamp((-1.0, 0.5), (0.3, 0.3), 90.0), Lamp((1.2, -0.5), (0.3, 0.3), 90.0, (1.0, 0.92, 0.8))),
+        objects=(SceneObject("Box", "box", (0.4, 0.4, 0.4), _on_floor(room, 0.85, 0.1), (0.55, 0.5, 0.45),
+                             rotation_z=30.0),),
+        probe=(0.2, 0.3, 1.6),
+        remove="Box",
+        render=_PHOTO_RENDER,
+        windows=(Window("west", (0.0, 1.4), (2.0, 1.6), 4.0, (0.92, 0.96, 1.0)),),
+    )
+
+
+def _warehouse_far_box() -> SceneSpec:
+    room = Room(lo=(-2.5, -2.5, 0.0), hi=(2.5, 2.5, 3.0), wall_albedo=(0.7, 0.7, 0.7),
+                floor=_photo_floor("warehouse.exr"))
+    return SceneSpec(
+        name="warehouse_far_box",
+        room=room,
+        lamps=(Lamp((0.0, 0.8), (1.4, 0.15), 50.0),),
+        objects=(SceneObject("Crate", "box", (0.5, 0.5, 0.4), _on_floor(room, -1.3, 1.2), (0.35, 0.4, 0.45),
+                             rotation_z=-10.0),),
+        probe=(0.2, 0.0, 1.6),
+        remove="Crate",
+        render=_PHOTO_RENDER,
+        windows=(Window("south", (0.0, 1.5), (2.4, 1.4), 4.0),),
+    )
+
+
 PHOTO_SPECS: dict[str, SceneSpec] = {s.name: s for s in (
     _hotel_box(),
     _hotel_chair(),
@@ -901,6 +969,12 @@ PHOTO_SPECS: dict[str, SceneSpec] = {s.name: s for s in (
     _workshop_box(),
     _hotel_rug_box(),
     _apartment_sun_box(),
+    _hotel_rug_stool(),
+    _hotel_rug_box_far("hotel_rug_middle_box", 0.35, -0.45, 0.4, 10.0),
+    _hotel_rug_box_far("hotel_rug_corner_box", -0.95, 0.4, 0.35, 25.0),
+    _hotel_rug_box_far("hotel_shadow_edge_box", 0.25, 0.45, 0.35, 15.0),
+    _lobby_bench_box(),
+    _warehouse_far_box(),
 )}
 
 
