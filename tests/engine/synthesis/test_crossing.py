@@ -66,6 +66,21 @@ def test_a_lane_in_line_across_one_floor_runs_on_across_the_hole() -> None:
     assert (sides != crossing.band).all() and len(np.unique(sides)) == 1  # one floor on both sides
 
 
+@pytest.mark.parametrize("far", ["green", "brown"])
+def test_a_band_runs_on_under_a_stool_whose_legs_reach_through_it(far: str) -> None:
+    """A round seat above the lane, its legs reaching down through the lane into the floor beyond:
+    the lane meets the hole's border in wide runs on either side of the legs, with a narrow side
+    between them."""
+    truth, across = _lane(far=_GREEN if far == "green" else _BROWN, width=10.0, slope=0.1)
+    rows, cols = np.indices((_H, _W))
+    hole = (np.hypot(rows - 44, cols - 80) <= 14) | ((rows >= 44) & (rows < 84) & (np.abs(cols - 80) <= 3))
+    crossing = find_crossing(np.where(hole[..., None], 0.0, truth), ~hole, hole)
+    assert crossing is not None
+    band = crossing.regions == crossing.band
+    assert band[hole & (np.abs(across) < 3.0)].all()
+    assert not band[hole & (np.abs(across) > 8.0)].any()
+
+
 def test_a_striped_band_of_the_floor_s_mean_colour_is_told_by_its_texture() -> None:
     """A rug's black and white stripes, averaging to the floor's colour over a few cells, crossing
     the hole between two floors that read as one colour."""
