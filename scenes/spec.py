@@ -736,6 +736,16 @@ def _apartment_room() -> Room:
                 floor=_photo_floor("apartment.exr"))
 
 
+def _lobby_room() -> Room:
+    return Room(lo=(-3.0, -2.5, 0.0), hi=(3.0, 2.5, 2.8), wall_albedo=(0.75, 0.75, 0.72),
+                floor=_photo_floor("lobby.exr"))
+
+
+def _warehouse_room() -> Room:
+    return Room(lo=(-2.5, -2.5, 0.0), hi=(2.5, 2.5, 3.0), wall_albedo=(0.7, 0.7, 0.7),
+                floor=_photo_floor("warehouse.exr"))
+
+
 def _hotel_box() -> SceneSpec:
     # A 0.5 m box on the wood between the striped rug and the desk chair's foot.
     room = _hotel_room()
@@ -806,8 +816,7 @@ def _apartment_chair() -> SceneSpec:
 
 def _lobby_stool() -> SceneSpec:
     # The lobby's wood floor with its red benches and a backpack printed on it; spots in a row.
-    room = Room(lo=(-3.0, -2.5, 0.0), hi=(3.0, 2.5, 2.8), wall_albedo=(0.75, 0.75, 0.72),
-                floor=_photo_floor("lobby.exr"))
+    room = _lobby_room()
     return SceneSpec(
         name="lobby_stool",
         room=room,
@@ -825,8 +834,7 @@ def _lobby_stool() -> SceneSpec:
 def _warehouse_box() -> SceneSpec:
     # Plain concrete under strip lights, an orange crate (its colour bleeds onto the grey), daylight
     # from the north.
-    room = Room(lo=(-2.5, -2.5, 0.0), hi=(2.5, 2.5, 3.0), wall_albedo=(0.7, 0.7, 0.7),
-                floor=_photo_floor("warehouse.exr"))
+    room = _warehouse_room()
     return SceneSpec(
         name="warehouse_box",
         room=room,
@@ -928,8 +936,7 @@ def _hotel_rug_box_far(name: str, x: float, y: float, size: float, rotation: flo
 
 
 def _lobby_bench_box() -> SceneSpec:
-    room = Room(lo=(-3.0, -2.5, 0.0), hi=(3.0, 2.5, 2.8), wall_albedo=(0.75, 0.75, 0.72),
-                floor=_photo_floor("lobby.exr"))
+    room = _lobby_room()
     return SceneSpec(
         name="lobby_bench_box",
         room=room,
@@ -944,8 +951,7 @@ def _lobby_bench_box() -> SceneSpec:
 
 
 def _warehouse_far_box() -> SceneSpec:
-    room = Room(lo=(-2.5, -2.5, 0.0), hi=(2.5, 2.5, 3.0), wall_albedo=(0.7, 0.7, 0.7),
-                floor=_photo_floor("warehouse.exr"))
+    room = _warehouse_room()
     return SceneSpec(
         name="warehouse_far_box",
         room=room,
