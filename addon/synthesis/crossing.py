@@ -129,8 +129,9 @@ def _lined_up_band(labels: np.ndarray, log_y: np.ndarray, hole: np.ndarray, *, r
                    reach: int) -> tuple[int, list[np.ndarray]] | None:
     """The band among `labels` read around `hole` (`_band`) and its cells where it meets the hole
     on each side, or None where none is found, its cells there are too few to place it, or it has
-    one material on both sides and is much darker than that (`log_y`: log luminance) or does not
-    line up across the hole (`_in_line`)."""
+    one material on both sides and is much darker than the commonest material of the ring
+    (`log_y`: log luminance, each cell's local mean) or does not line up across the hole
+    (`_in_line`)."""
     found = _band(_border_sequence(labels, annulus, directions))
     if found is None:
         return None
