@@ -865,23 +865,6 @@ def _workshop_box() -> SceneSpec:
     )
 
 
-def _hotel_rug_box() -> SceneSpec:
-    # The hotel's floor again, a box standing half on the striped rug: the rug's straight edge runs
-    # on under it.
-    room = _hotel_room()
-    return SceneSpec(
-        name="hotel_rug_box",
-        room=room,
-        lamps=(Lamp((-0.5, 1.5), (0.3, 0.3), 30.0, (1.0, 0.9, 0.75)), Lamp((0.6, -0.6), (0.3, 0.3), 20.0)),
-        objects=(SceneObject("Box", "box", (0.4, 0.4, 0.4), _on_floor(room, -0.45, 0.3), (0.45, 0.5, 0.55),
-                             rotation_z=-29.0),),
-        probe=(0.3, 1.2, 1.5),
-        remove="Box",
-        render=_PHOTO_RENDER,
-        windows=(Window("east", (0.5, 1.4), (1.6, 1.7), 5.0, (1.0, 0.97, 0.92)),),
-    )
-
-
 def _apartment_sun_box() -> SceneSpec:
     # The apartment's floor with the sunlit patch printed on it, a box standing on the patch's
     # straight left edge: the edge between the bright and the plain wood runs on under it.
@@ -899,12 +882,6 @@ def _apartment_sun_box() -> SceneSpec:
     )
 
 
-# Placed after the engine's rules for the rug, the sun patch and the lane were made, on the same
-# photographs: the rug under a stool between the bed and the wood, its middle under a box whose
-# hidden floor reaches the raster's edge, its corner under a box; the desk's printed shadow edge;
-# a box beside the lobby's bench; a crate on the warehouse's open concrete.
-
-
 def _hotel_rug_stool() -> SceneSpec:
     room = _hotel_room()
     return SceneSpec(
@@ -920,7 +897,8 @@ def _hotel_rug_stool() -> SceneSpec:
     )
 
 
-def _hotel_rug_box_far(name: str, x: float, y: float, size: float, rotation: float) -> SceneSpec:
+def _hotel_floor_box(name: str, x: float, y: float, size: float, rotation: float) -> SceneSpec:
+    # The hotel's floor again, a box standing at (x, y) under two lamps and the east window.
     room = _hotel_room()
     return SceneSpec(
         name=name,
@@ -973,12 +951,17 @@ PHOTO_SPECS: dict[str, SceneSpec] = {s.name: s for s in (
     _lobby_stool(),
     _warehouse_box(),
     _workshop_box(),
-    _hotel_rug_box(),
+    # a box standing half on the striped rug: the rug's straight edge runs on under it
+    _hotel_floor_box("hotel_rug_box", -0.45, 0.3, 0.4, -29.0),
     _apartment_sun_box(),
+    # Placed after the engine's rules for the rug, the sun patch and the lane were made, on the
+    # same photographs: the rug under a stool between the bed and the wood, its middle under a box
+    # whose hidden floor reaches the raster's edge, its corner under a box; the desk's printed
+    # shadow edge; a box beside the lobby's bench; a crate on the warehouse's open concrete.
     _hotel_rug_stool(),
-    _hotel_rug_box_far("hotel_rug_middle_box", 0.35, -0.45, 0.4, 10.0),
-    _hotel_rug_box_far("hotel_rug_corner_box", -0.95, 0.4, 0.35, 25.0),
-    _hotel_rug_box_far("hotel_shadow_edge_box", 0.25, 0.45, 0.35, 15.0),
+    _hotel_floor_box("hotel_rug_middle_box", 0.35, -0.45, 0.4, 10.0),
+    _hotel_floor_box("hotel_rug_corner_box", -0.95, 0.4, 0.35, 25.0),
+    _hotel_floor_box("hotel_shadow_edge_box", 0.25, 0.45, 0.35, 15.0),
     _lobby_bench_box(),
     _warehouse_far_box(),
 )}
