@@ -260,6 +260,18 @@ def _run_cells(cells: np.ndarray, directions: np.ndarray, start: int, length: in
     return np.argwhere(cells & inside).astype(np.float64)
 
 
+def _axis(first: np.ndarray, second: np.ndarray
+          ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float] | None:
+    """The line from the mean of the cells `first` (N, 2) to that of `second`: its two ends, the
+    unit vectors along and across it, and its length; None where the two means coincide."""
+    a, b = first.mean(axis=0), second.mean(axis=0)
+    length = float(np.linalg.norm(b - a))
+    if length < 1e-9:
+        return None
+    along = (b - a) / length
+    return a, b, along, np.array([-along[1], along[0]]), length
+
+
 def _across(cells: np.ndarray, across: np.ndarray) -> tuple[float, float]:
     """How far `cells` (N, 2) reach along the unit vector `across` (5th and 95th percentiles)."""
     lo, hi = np.percentile(cells @ across, [5, 95])
@@ -272,12 +284,10 @@ def _in_line(labels: np.ndarray, near: np.ndarray, band: int, first: np.ndarray,
     other (`second`) line up across it: their extents across the line joining them overlapping by
     `_OVERLAP` of both together, and the band running on straight away from the hole past one of
     them (`_RUNS_ON` of the `near` cells of `labels` within `reach` past it and within its extent)."""
-    a, b = first.mean(axis=0), second.mean(axis=0)
-    length = float(np.linalg.norm(b - a))
-    if length < 1e-9:
+    axis = _axis(first, second)
+    if axis is None:
         return False
-    along = (b - a) / length
-    across = np.array([-along[1], along[0]])
+    a, b, along, across, _ = axis
     cells, seen = np.argwhere(near), labels[near]
     extents, runs_on = [], []
     for end, at_end, outward in ((a, first, -along), (b, second, along)):
@@ -297,12 +307,10 @@ def _strip(hole: np.ndarray, first: np.ndarray, second: np.ndarray) -> np.ndarra
     """(h, w) the hole cells of the straight strip joining the band's cells where it meets the
     hole on one side (`first`, (N, 2)) to the other's, its width measured across it at each end
     and interpolated between."""
-    a, b = first.mean(axis=0), second.mean(axis=0)
-    length = float(np.linalg.norm(b - a))
-    if length < 1e-9:
+    axis = _axis(first, second)
+    if axis is None:
         return np.zeros_like(hole)
-    along = (b - a) / length
-    across = np.array([-along[1], along[0]])
+    a, _, along, across, length = axis
     offsets, widths = [], []
     for cells in (first, second):
         lo, hi = _across(cells, across)
