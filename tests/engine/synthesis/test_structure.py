@@ -3,7 +3,9 @@ composes a hole from shifted copies, and the blend; against hand-made periodic a
 import numpy as np
 import pytest
 
+from addon.segmentation.masks import dilate
 from addon.synthesis import structure
+from addon.synthesis.material import ring_widths
 from addon.synthesis.shift_map import candidate_shifts, lattice_shifts, shift_map
 from addon.synthesis.structure import fill_structured, structure_fill
 from addon.synthesis.texture import SynthesisParams
@@ -172,6 +174,21 @@ def test_a_band_of_shadow_left_along_the_border_does_not_put_tiles_out_of_phase(
     got = structure_fill(seen, ~hole, hole)
     assert got is not None and got.covered[hole].all()
     assert _band_pass_correlation(got.image, truth, hole) >= 0.9
+
+
+@pytest.mark.parametrize("tint, composed", [(1.0, True), (1.15, False)])
+def test_copies_in_colours_the_ring_does_not_show_are_no_composition(tint, composed):
+    """The exemplar's colours are told with a step's tolerance, so it may hold a region of another
+    colour beyond the ring around the hole (the lit side of a bed). Where the shift map copies
+    that into the hole (here drawn to it by what the repainted pixels show), the synthesis fills
+    alone; the same floor in one colour is composed."""
+    hole = _hole(160, 60, 100)
+    colour = np.array([1.0, tint, 1.0 / tint], np.float32)
+    floor = _tiles() * np.array([1.0, 0.85, 0.65], np.float32)
+    beyond = ~dilate(hole, ring_widths(hole)[0] + 1)
+    seen = np.where(hole[..., None], 0, np.where(beyond[..., None], floor * colour, floor))
+    got = structure_fill(seen, ~hole, hole, guide=floor * colour, guided=hole)
+    assert (got is not None) == composed
 
 
 def test_sharp_sources_preferred_over_coarse_ones():
