@@ -73,7 +73,8 @@ def structure_fill(image: np.ndarray, known: np.ndarray, hole: np.ndarray, *, fo
                    guide: np.ndarray | None = None, guided: np.ndarray | None = None,
                    seed: int = 0) -> StructureFill | None:
     """The `hole` of `image` (H, W, C) composed from shifted copies of its `known` pixels, or
-    None where the texture has no dominant translation or no copy reaches the hole. On planks
+    None where the texture has no dominant translation, no copy reaches the hole, or the copies
+    bring colours the ring around the hole does not show (`_foreign_share`). On planks
     (`_plank_axis`) each line along them is interpolated between its visible ends instead
     (`lines`), the copies giving only their fine detail. `guide` (H, W, C) is what the
     photograph shows at the `guided` hole pixels, which were seen but repainted (`shift_map`).
