@@ -9,12 +9,13 @@ the lobby, corners of a rough box read off the panorama), the object a box of a 
 eye, its near bottom edge placed where the photograph shows the object's feet touch the floor.
 The .blend is saved under out/real_photo_crops/<scene>/ and the removal runs through the
 command line exactly as a user runs it (`python -m addon.cli remove SCENE.blend --object NAME
---align --out DIR`, balanced). PatchMatch (the benchmark environment .venv-bench, which
+--align --out DIR`, balanced, then again at `--quality draft`, the preset a first look takes).
+PatchMatch (the benchmark environment .venv-bench, which
 `./dev bench-synthesis` sets up) then fills the same panorama, tone-mapped to 8 bits as a 2D
 tool gets a photograph, over a generous mask: the pixels near the object whose colour our run
-changed by more than 35 %, dilated, holes filled. Writes docs/images/real_<scene>_<object>.png
-(photograph | ours | PatchMatch) and docs/results/real_photo_crops.md (the commands, seconds
-and the report's warnings).
+changed by more than 35 % at balanced, dilated, holes filled. Writes
+docs/images/real_<scene>_<object>.png (photograph | ours, balanced | ours, draft | PatchMatch) and
+docs/results/real_photo_crops.md (the commands, seconds and the report's warnings).
 """
 from __future__ import annotations
 
@@ -122,9 +123,10 @@ def build(scene: PhotoScene, folder: Path) -> tuple[Path, np.ndarray]:
     return path, corners - room.probe
 
 
-def remove_command(blend: Path, object_name: str, out: Path) -> list[str]:
+def remove_command(blend: Path, object_name: str, out: Path, *, quality: str = "balanced") -> list[str]:
+    preset = [] if quality == "balanced" else ["--quality", quality]
     return [".venv/bin/python", "-m", "addon.cli", "remove", str(blend.relative_to(ROOT)), "--object", object_name,
-            "--align", "--out", str(out.relative_to(ROOT))]
+            "--align", *preset, "--out", str(out.relative_to(ROOT))]
 
 
 def luminance(image: np.ndarray) -> np.ndarray:
@@ -226,39 +228,47 @@ def side_by_side(panels: list[np.ndarray]) -> np.ndarray:
 
 
 def crops(scene: PhotoScene, table: Table) -> list[str]:
-    """Build, remove, fill with PatchMatch, write the picture; one table row; the notes (the
-    command, the report's warnings and alignment)."""
+    """Build, remove at balanced and at draft, fill with PatchMatch, write the picture; one table
+    row; the notes (the commands, the balanced report's warnings and alignment)."""
     folder = OUT / scene.name
     blend, corners = build(scene, folder)
-    command = remove_command(blend, scene.object_name, folder / "removed")
-    started = time.perf_counter()
-    subprocess.run(command, check=True, cwd=ROOT)
-    wall = time.perf_counter() - started
-    report = json.loads((folder / "removed" / "report.json").read_text())
-    image, mask_pixels, pm_seconds = compare(scene, corners, folder / "removed" / "edited.exr")
+    runs = {quality: _removed(blend, scene.object_name, folder / out, quality=quality)
+            for quality, out in (("balanced", "removed"), ("draft", "removed_draft"))}
+    (command, wall, report), (draft_command, draft_wall, _) = runs["balanced"], runs["draft"]
+    image, mask_pixels, pm_seconds = compare(scene, corners, folder / "removed" / "edited.exr",
+                                             folder / "removed_draft" / "edited.exr")
     seg, align = report.get("segmentation", {}), report.get("alignment", {})
     table.row(scene.name, scene.object_name, f"{wall:.1f}", f"{report['seconds']['total']:.1f}",
-              f"{report['seconds'].get('local', 0.0):.1f}", seg.get("agreement", "-"),
+              f"{report['seconds'].get('local', 0.0):.1f}", f"{draft_wall:.1f}", seg.get("agreement", "-"),
               "applied" if align.get("applied") else "left as modelled", mask_pixels, f"{pm_seconds:.1f}",
               f"[{image.name}](../images/{image.name})")
-    return [f"![{scene.name}: photograph, ours, PatchMatch](../images/{image.name})",
-            f"{scene.name}: `{' '.join(command)}`"] + [f"{scene.name} warning: {w}" for w in report["warnings"]] \
+    return [f"![{scene.name}: photograph, ours (balanced), ours (draft), PatchMatch](../images/{image.name})",
+            f"{scene.name}: `{' '.join(command)}`", f"{scene.name}, draft: `{' '.join(draft_command)}`"] \
+        + [f"{scene.name} warning: {w}" for w in report["warnings"]] \
         + ([f"{scene.name} alignment: {align['message']}"] if align.get("message") else [])
 
 
-def compare(scene: PhotoScene, corners: np.ndarray, edited: Path) -> tuple[Path, int, float]:
-    """PatchMatch's fill of the region our run changed, and the picture photograph | ours |
-    PatchMatch; its path, the mask's pixels and PatchMatch's seconds."""
+def _removed(blend: Path, object_name: str, out: Path, *, quality: str) -> tuple[list[str], float, dict]:
+    """The removal through the command line: its command, wall seconds and report."""
+    command = remove_command(blend, object_name, out, quality=quality)
+    started = time.perf_counter()
+    subprocess.run(command, check=True, cwd=ROOT)
+    return command, time.perf_counter() - started, json.loads((out / "report.json").read_text())
+
+
+def compare(scene: PhotoScene, corners: np.ndarray, edited: Path, draft: Path) -> tuple[Path, int, float]:
+    """PatchMatch's fill of the region our balanced run changed, and the picture photograph |
+    ours, balanced | ours, draft | PatchMatch; its path, the mask's pixels and PatchMatch's seconds."""
     from addon.io.exr import read_exr, write_png
 
-    before, after = read_exr(scene.panorama), read_exr(edited)
+    before, after, after_draft = read_exr(scene.panorama), read_exr(edited), read_exr(draft)
     height, width = before.shape[:2]
     mask = patchmatch_mask(before, after, padded_box(silhouette_box(corners, width, height), pad_share=0.25))
     box = padded_box(mask, pad_share=0.25)
     white = float(np.percentile(luminance(before)[box][~mask[box]], 97))
     filled, seconds = run_patchmatch(display(before, white), mask)
     image = ROOT / "docs" / "images" / f"real_{scene.name}_{scene.object_name.lower()}.png"
-    write_png(image, side_by_side([display(before[box], white), display(after[box], white), filled[box]]))
+    write_png(image, side_by_side([display(x[box], white) for x in (before, after, after_draft)] + [filled[box]]))
     return image, int(mask.sum()), seconds
 
 
@@ -280,9 +290,9 @@ def main() -> None:
         patchmatch_step(args.patchmatch)
         return
     scenes = _scenes()
-    table = Table(["scene", "object", "CLI s (wall)", "report s", "local s", "outline agreement",
+    table = Table(["scene", "object", "CLI s (wall)", "report s", "local s", "draft CLI s (wall)", "outline agreement",
                    "Align to Photo", "PatchMatch mask px", "PatchMatch s", "picture"],
-                  title="Removal on real photographs (balanced, --align): photograph | ours | PatchMatch")
+                  title="Removal on real photographs (--align): photograph | ours, balanced | ours, draft | PatchMatch")
     notes = [f"The engine at commit {_engine_version()}."]
     for name in args.scenes.split(","):
         notes += crops(scenes[name], table)
