@@ -98,10 +98,15 @@ def find_crossing(image: np.ndarray, known: np.ndarray, hole: np.ndarray) -> Cro
         return None  # decided before the colours are: most holes on a floor's edge end here
     log_y = log_luminance(image)
     colour = colour_features(image, log_y, known, radius=2)
-    textured = np.concatenate([colour, log_spread(log_y, known, colour[..., 0], radius=2)[..., None]], axis=-1)
+
+    def textured() -> np.ndarray:
+        spread = log_spread(log_y, known, colour[..., 0], radius=2)
+        return np.concatenate([colour, spread[..., None]], axis=-1) / _SCALE
+
     # Colour alone first: along every edge between two colours the spread is high too, and there
-    # it reads as a colour of its own
-    for features in (colour / _SCALE[:3], textured / _SCALE):
+    # it reads as a colour of its own. The texture is read only where colour finds no band.
+    for read in (lambda: colour / _SCALE[:3], textured):
+        features = read()
         labels = np.full(hole.shape, -1)
         labels[near] = _colour_labels(features[ring], features[near])
         found = _lined_up_band(labels, colour[..., 0], hole, ring=ring, near=near, annulus=annulus,
@@ -289,11 +294,11 @@ def _in_line(labels: np.ndarray, near: np.ndarray, band: int, first: np.ndarray,
         return False
     a, b, along, across, _ = axis
     cells, seen = np.argwhere(near), labels[near]
+    offset = cells @ across
     extents, runs_on = [], []
     for end, at_end, outward in ((a, first, -along), (b, second, along)):
         lo, hi = _across(at_end, across)
         past = (cells - end) @ outward
-        offset = cells @ across
         corridor = (past > 0) & (past <= reach) & (offset >= lo) & (offset <= hi)
         extents.append((lo, hi))
         runs_on.append(corridor.sum() >= 0.5 * reach * max(hi - lo, 1.0)
