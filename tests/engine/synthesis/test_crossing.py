@@ -66,6 +66,30 @@ def test_a_lane_in_line_across_one_floor_runs_on_across_the_hole() -> None:
     assert (sides != crossing.band).all() and len(np.unique(sides)) == 1  # one floor on both sides
 
 
+
+def test_a_side_lit_brighter_along_its_far_border_meets_both_its_colours() -> None:
+    """Below the lane, light printed on the floor along the hole's lower border reads as a colour
+    of its own, the commonest beside the lower piece. The piece meets the dark floor beside it
+    as well as the lit one: taken from the lit colour alone its level is 2.5 times the dark
+    floor's at the hole's sides."""
+    truth, across = _lane(slope=0.0)
+    rows, cols = np.indices((_H, _W))
+    lit = (rows >= 74) & (cols >= 40) & (cols < 122)
+    truth[lit] *= 3.0
+    hole = _hole()
+    image = np.where(hole[..., None], 0.0, truth)
+    crossing = find_crossing(image, ~hole, hole)
+    assert crossing is not None
+    lower = crossing.regions[hole & (across > 6)]
+    assert len(np.unique(lower)) == 1 and (crossing.labels[lit & ~hole & (rows < 84)] == lower[0]).mean() > 0.9
+    filled = fill_crossing(crossing, image, ~hole, SynthesisParams(), seed=0)
+    sides = hole & (across > 6) & ~lit & ((cols < 64) | (cols > 97))
+    ratio = _region_means(filled.image, sides) / _region_means(truth, sides)
+    assert (ratio < 1.6).all()
+    lit_part = hole & lit & (rows > 75)
+    np.testing.assert_allclose(_region_means(filled.image, lit_part), _region_means(truth, lit_part), rtol=0.1)
+
+
 @pytest.mark.parametrize("far", ["green", "brown"])
 def test_a_band_runs_on_under_a_stool_whose_legs_reach_through_it(far: str) -> None:
     """A round seat above the lane, its legs reaching down through the lane into the floor beyond:
