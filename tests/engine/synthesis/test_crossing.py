@@ -157,10 +157,25 @@ def test_a_band_seen_on_one_side_only_is_no_crossing() -> None:
     assert find_crossing(np.where(known[..., None], truth, 0.0), known, hole) is None
 
 
-def test_a_border_not_seen_all_around_tells_no_crossing() -> None:
-    truth, _ = _lane()
+def test_a_band_lined_up_across_a_border_partly_unseen_runs_on() -> None:
+    truth, across = _lane()
     hole = _hole()
     rows, cols = np.indices((_H, _W))
     known = ~hole & ~((rows < 44) & (cols >= 56) & (cols <= 106))  # the floor above the hole unseen
-    assert find_crossing(np.where(known[..., None], truth, 0.0), known, hole) is None
-    assert find_crossing(np.where(hole[..., None], 0.0, truth), ~hole, hole) is not None
+    crossing = find_crossing(np.where(known[..., None], truth, 0.0), known, hole)
+    assert crossing is not None
+    band = crossing.regions == crossing.band
+    assert band[hole & (np.abs(across) < 2.0)].all()
+    assert not band[hole & (np.abs(across) > 6.0)].any()
+
+
+def test_the_floor_between_two_colours_and_a_gap_is_no_band() -> None:
+    """The floor meets the hole above and below it, a yellow patch on its left, a brown one and
+    the raster's edge on its right: the floor is the hole's material, not a band between them."""
+    image, _ = _lane(far=_GREEN, width=0.0)
+    hole = _hole()
+    rows, cols = np.indices((_H, _W))
+    image[(cols < 62) & (rows >= 50) & (rows < 72)] = _YELLOW
+    image[(cols > 100) & (rows >= 50) & (rows < 60)] = _BROWN
+    known = ~hole & ((cols < 101) | ((rows >= 50) & (rows < 60)))
+    assert find_crossing(np.where(known[..., None], image, 0.0), known, hole) is None
