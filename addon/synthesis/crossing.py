@@ -115,7 +115,7 @@ def find_crossing(image: np.ndarray, known: np.ndarray, hole: np.ndarray) -> Cro
         features = read()
         labels = np.full(hole.shape, -1)
         labels[near] = _colour_labels(features[ring], features[near])
-        found = _lined_up_band(labels, colour[..., 0], hole, ring=ring, near=near, annulus=annulus,
+        found = _lined_up_band(labels, colour, hole, ring=ring, near=near, annulus=annulus,
                                directions=directions, reach=reach, partial=partial)
         if found is not None:
             break
@@ -135,14 +135,15 @@ def find_crossing(image: np.ndarray, known: np.ndarray, hole: np.ndarray) -> Cro
     return Crossing(regions=regions, labels=labels, band=band)
 
 
-def _lined_up_band(labels: np.ndarray, log_y: np.ndarray, hole: np.ndarray, *, ring: np.ndarray,
+def _lined_up_band(labels: np.ndarray, colour: np.ndarray, hole: np.ndarray, *, ring: np.ndarray,
                    near: np.ndarray, annulus: np.ndarray, directions: np.ndarray,
                    reach: int, partial: bool) -> tuple[int, list[np.ndarray]] | None:
     """The band among `labels` read around `hole` (`_band`; `_unseen_band` where the border is
     `partial`ly seen) and its cells where it meets the hole on each side, or None where none is
-    found, its cells there are too few to place it, or it has one material on both sides (or
-    sides not seen) and is much darker than the commonest material of the ring (`log_y`: log
-    luminance, each cell's local mean) or does not line up across the hole (`_in_line`)."""
+    found, its cells there are too few to place it or differ in chromaticity (`colour`: log
+    luminance and chromaticity, each cell's local mean) from one side to the other, or it has one material
+    on both sides (or sides not seen) and is much darker than the commonest material of the ring
+    or does not line up across the hole (`_in_line`)."""
     around = _border_sequence(labels, annulus, directions)
     found = _unseen_band(around, np.bincount(labels[ring & (labels >= 0)]).argmax()) if partial else _band(around)
     if found is None:
@@ -152,9 +153,16 @@ def _lined_up_band(labels: np.ndarray, log_y: np.ndarray, hole: np.ndarray, *, r
     ends = [_run_cells(inner, directions, start, length) for start, length in runs]
     if min(len(e) for e in ends) < 4:
         return None
+    # Light printed on the floor may change a band's luminance from one side to the other, not
+    # its chromaticity: a sunlit patch and a yellow armchair printed on the floor, smooth and
+    # bright both, share a texture's colour (photo-textured hotel_chair at 1024x512: 4.5 apart in
+    # chromaticity at the two ends; the bands of the other photo truths 0.4-1.2).
+    at_ends = [np.median(colour[tuple(e.astype(np.int64).T)][:, 1:], axis=0) / _SCALE[1:3] for e in ends]
+    if np.linalg.norm(at_ends[0] - at_ends[1]) >= _MERGE:
+        return None  # two things of one texture, not one band
     if not apart:
         material = np.bincount(labels[ring & (labels >= 0) & (labels != band)]).argmax()
-        level = [np.median(log_y[ring & (labels == label)]) for label in (band, material)]
+        level = [np.median(colour[..., 0][ring & (labels == label)]) for label in (band, material)]
         if level[0] < level[1] - np.log(_FEET) or not _in_line(labels, near, band, *ends, reach=reach):
             return None
     return band, ends

@@ -129,6 +129,23 @@ def test_a_stripe_out_of_line_across_one_floor_is_no_band() -> None:
     assert find_crossing(image, ~hole, hole) is None
 
 
+
+@pytest.mark.parametrize("seed", [0, 1, 3])
+def test_two_smooth_stripes_of_other_colours_in_line_are_no_band(seed: int) -> None:
+    """A grey stripe reaching the hole from the left and a yellow one from the right, in line,
+    both smooth on a grainy floor: the texture reads them as one colour (as it does for these
+    grains without the chromaticity test), but they are two things that meet under the object (a
+    sunlit patch, a printed armchair), not one band."""
+    rng = np.random.default_rng(seed)
+    _, across = _lane(width=8.0)
+    cols = np.indices((_H, _W))[1]
+    image = np.where((across < 0)[..., None], _GREEN, _BROWN) * (1 + 0.08 * rng.standard_normal((_H, _W)))[..., None]
+    stripe = np.abs(across) <= 4
+    image[stripe] = np.where((cols < 80)[..., None], np.array([0.4, 0.42, 0.45]), _YELLOW)[stripe]
+    hole = _hole()
+    assert find_crossing(np.where(hole[..., None], 0.0, image), ~hole, hole) is None
+
+
 @pytest.mark.parametrize("case", ["checker", "plain"])
 def test_nothing_crosses_where_nothing_tells_it_does(case: str) -> None:
     hole = _hole()
