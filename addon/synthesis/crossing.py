@@ -140,10 +140,10 @@ def _lined_up_band(labels: np.ndarray, colour: np.ndarray, hole: np.ndarray, *, 
                    reach: int, partial: bool) -> tuple[int, list[np.ndarray]] | None:
     """The band among `labels` read around `hole` (`_band`; `_unseen_band` where the border is
     `partial`ly seen) and its cells where it meets the hole on each side, or None where none is
-    found, its cells there are too few to place it or differ in chromaticity (`colour`: log
-    luminance and chromaticity, each cell's local mean) from one side to the other, or it has one material
-    on both sides (or sides not seen) and is much darker than the commonest material of the ring
-    or does not line up across the hole (`_in_line`)."""
+    found, its cells there are too few to place it or differ in chromaticity from one side to the
+    other (`colour`: log luminance and chromaticity, each cell's local mean), or it has one
+    material on both sides (or sides not seen) and is much darker than the commonest material of
+    the ring or does not line up across the hole (`_in_line`)."""
     around = _border_sequence(labels, annulus, directions)
     found = _unseen_band(around, np.bincount(labels[ring & (labels >= 0)]).argmax()) if partial else _band(around)
     if found is None:
