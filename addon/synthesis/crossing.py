@@ -185,10 +185,9 @@ def fill_crossing(crossing: Crossing, image: np.ndarray, known: np.ndarray, para
     cells of its own colour near the hole and brought to the membrane over it of the means (a few
     cells wide) of the cells beside it, its own grain (luminance over its mean) kept: the band's
     own colour's cells, a side's those of its own colour and of each other colour but the band's
-    common beside it (`_side_cells`). A region whose colour has
-    too few cells for the synthesis (a narrow band's) takes the grain of all the cells seen; one
-    with no such cell beside it, the synthesis's level. Raises `DimredError` where too little is
-    seen to synthesise at all."""
+    common beside it (`_side_cells`). A region whose colour has too few cells for the synthesis
+    (a narrow band's) takes the grain of all the cells seen; one with no such cell beside it, the
+    synthesis's level. Raises `DimredError` where too little is seen to synthesise at all."""
     out = np.asarray(image, np.float32).copy()
     sources = np.full((*known.shape, 2), -1, np.int64)
     done = known & ~(crossing.regions >= 0)
@@ -219,7 +218,7 @@ def _side_cells(crossing: Crossing, done: np.ndarray, piece: np.ndarray, label: 
     `_SIDE_COLOUR` of the cells with a colour within `_BESIDE` cells of the piece."""
     labels = np.where(done & dilate(piece, _BESIDE), crossing.labels, -1)
     labels[labels == crossing.band] = -1
-    count = np.bincount(labels[labels >= 0], minlength=label + 1)
+    count = np.bincount(labels[labels >= 0])
     side = np.flatnonzero(count >= _SIDE_COLOUR * max(count.sum(), 1))
     return done & np.isin(crossing.labels, np.append(side, label))
 
