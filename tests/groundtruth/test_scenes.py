@@ -44,7 +44,7 @@ def rotated() -> S.SceneSpec:
 
 # --- specs (no rendering) -------------------------------------------------------------------
 
-ALL_SPECS = {**S.SPECS, **S.PHOTO_SPECS}
+ALL_SPECS = {**S.SPECS, **S.PHOTO_SPECS, **S.HELD_OUT_SPECS}
 
 
 def test_spec_json_round_trip_and_key() -> None:
@@ -70,6 +70,18 @@ def test_fields_added_for_photo_rooms_leave_the_other_keys_alone() -> None:
             spec.room, floor=S.Floor(), wall_photo=None), objects=tuple(
             dataclasses.replace(o, kind="box", seat_height=None) for o in spec.objects))
         assert not plain.extended()
+
+
+def test_held_out_scenes_move_only_the_object_of_a_photo_room() -> None:
+    # Each stands in a tuned scene's room, under its lamps and windows, with the same object
+    # elsewhere: what differs is where the fill's rules meet the floor.
+    assert not set(S.HELD_OUT_SPECS) & (set(S.SPECS) | set(S.PHOTO_SPECS))
+    rooms = {(s.room, s.lamps, s.windows) for s in S.PHOTO_SPECS.values()}
+    placements = {(s.removed_object().location, s.removed_object().rotation_z) for s in S.PHOTO_SPECS.values()}
+    for spec in S.HELD_OUT_SPECS.values():
+        assert (spec.room, spec.lamps, spec.windows) in rooms
+        assert (spec.removed_object().location, spec.removed_object().rotation_z) not in placements
+        assert S.get(spec.name) is spec
 
 
 def test_spec_validation() -> None:
