@@ -8,7 +8,8 @@ the world's Mapping-node rotation and the Cycles settings; the photo-textured ro
 
 The named specs differ on purpose (room shape and placement, floor texture, lamp count, size
 and power, object kind, colour and position in the panorama) so that the engine is not tuned
-to one scene. Units are metres; colours are linear RGB albedos in [0, 1).
+to one scene; `HELD_OUT_SPECS` puts the photo rooms' objects where no rule of the engine was
+tuned. Units are metres; colours are linear RGB albedos in [0, 1).
 """
 from __future__ import annotations
 
