@@ -83,9 +83,9 @@ def main() -> None:
                "neighbour mean / total / detail", "printed under / around", "far damage", "bruise share",
                "light alone: total", "within bounds: ours / neighbour", "filled (source)", "seconds"]
     setting = f"{args.width}x{args.width // 2} at {args.samples} samples, balanced, exact proxies"
-    tables = {False: Table(columns, title=f"Tuned on: {setting}"),
-              True: Table(columns, title=f"Held out (placed after the rules were made, never tuned on): {setting}")}
-    within = {held: {"scenes": 0, "ours": 0, "neighbour": 0} for held in tables}
+    titles = {False: "Tuned on", True: "Held out (placed after the rules were made, never tuned on)"}
+    tables: dict[bool, Table] = {}  # each made when its first scene comes: a table prints its head then
+    within = {held: {"scenes": 0, "ours": 0, "neighbour": 0} for held in titles}
     for gt in ground_truths(args):
         s = gt.spec
         r = remove_object(gt.scene, s.remove, quality="balanced")
@@ -95,12 +95,15 @@ def main() -> None:
         light_alone = metrics.clean_removal_scores(gt.input, np.where(gt.mask[..., None], gt.truth, edit), gt.truth,
                                                    gt.mask)
         ours_in, neighbour_in = metrics.within_bounds(f), metrics.within_bounds(n)
-        count = within[s.name in HELD_OUT_SPECS]
+        held = s.name in HELD_OUT_SPECS
+        count = within[held]
         count["scenes"] += 1
         count["ours"] += ours_in
         count["neighbour"] += neighbour_in
         write_png(OUT / f"{s.name}.png", comparison([gt.input, gt.truth, edit], gt.mask))
-        tables[s.name in HELD_OUT_SPECS].row(
+        if held not in tables:
+            tables[held] = Table(columns, title=f"{titles[held]}: {setting}")
+        tables[held].row(
             s.name, s.room.floor.photo.source, s.removed_object().kind, f"{f['light']:.3f}",
             f"{metrics.noise_floor(gt.input, gt.truth, gt.mask):.3f}", f"{f['structure']:.3f}", f"{f['detail']:.2f}",
             f"{f['mean_error']:.3f}", f"{f['total']:.3f}",
@@ -112,7 +115,7 @@ def main() -> None:
     notes += [f"Within every bound, {'held out' if held else 'tuned on'}: ours on {c['ours']} of {c['scenes']} scenes, "
               f"the truth's neighbouring patch under the exact light on {c['neighbour']} of {c['scenes']}."
               for held, c in within.items() if c["scenes"]]
-    write(*(t for held, t in tables.items() if within[held]["scenes"]), notes=notes)
+    write(*tables.values(), notes=notes)
 
 
 if __name__ == "__main__":
