@@ -968,12 +968,17 @@ PHOTO_SPECS: dict[str, SceneSpec] = {s.name: s for s in (
 )}
 
 
+def _moved(spec: SceneSpec, name: str, location: Vec3, rotation_z: float) -> SceneSpec:
+    """`spec` named `name`, its removed object at `location`, turned to `rotation_z` degrees."""
+    obj = spec.removed_object()
+    moved = dataclasses.replace(obj, location=location, rotation_z=rotation_z)
+    return dataclasses.replace(spec, name=name, objects=tuple(moved if o is obj else o for o in spec.objects))
+
+
 def _placed(spec: SceneSpec, name: str, x: float, y: float, rotation_z: float) -> SceneSpec:
     """`spec` named `name`, its removed object standing at (x, y) on the floor, turned to
     `rotation_z` degrees."""
-    obj = spec.removed_object()
-    placed = dataclasses.replace(obj, location=_on_floor(spec.room, x, y), rotation_z=rotation_z)
-    return dataclasses.replace(spec, name=name, objects=tuple(placed if o is obj else o for o in spec.objects))
+    return _moved(spec, name, _on_floor(spec.room, x, y), rotation_z)
 
 
 #: The photo-textured rooms again with the object somewhere else, placed after every rule of the
@@ -1001,9 +1006,7 @@ def relocated(spec: SceneSpec, yaw: float, distance_scale: float) -> SceneSpec:
     dx, dy = obj.location[0] - spec.probe[0], obj.location[1] - spec.probe[1]
     x = spec.probe[0] + distance_scale * (math.cos(a) * dx - math.sin(a) * dy)
     y = spec.probe[1] + distance_scale * (math.sin(a) * dx + math.cos(a) * dy)
-    moved = dataclasses.replace(obj, location=(x, y, obj.location[2]), rotation_z=obj.rotation_z + yaw)
-    return dataclasses.replace(spec, name=f"{spec.name}_moved", objects=tuple(
-        moved if o.name == obj.name else o for o in spec.objects))
+    return _moved(spec, f"{spec.name}_moved", (x, y, obj.location[2]), obj.rotation_z + yaw)
 
 
 def get(name: str) -> SceneSpec:
